@@ -1,0 +1,73 @@
+//! The one error type of `latent_core`: every variant says what was wrong and where.
+
+/// Errors raised by the core when its inputs or numerics are unusable.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CoreError {
+    /// An array had the wrong shape.
+    #[error("{what}: expected shape {expected}, got {got}")]
+    Shape {
+        /// Which argument.
+        what: &'static str,
+        /// The shape that was expected, e.g. `(N, 2)`.
+        expected: String,
+        /// The shape that was given.
+        got: String,
+    },
+    /// An input held NaN or an infinity.
+    #[error("{what} contains a non-finite value ({value}) at flat index {index}")]
+    NonFinite {
+        /// Which argument.
+        what: &'static str,
+        /// Flat (row-major) index of the first bad value.
+        index: usize,
+        /// The bad value.
+        value: f64,
+    },
+    /// An input that must hold at least one element was empty.
+    #[error("{what} is empty")]
+    Empty {
+        /// Which argument.
+        what: &'static str,
+    },
+    /// A scalar parameter was outside its allowed range.
+    #[error("invalid parameter {name} = {value}: {reason}")]
+    InvalidParameter {
+        /// Parameter name.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must satisfy.
+        reason: &'static str,
+    },
+    /// The kernel matrix could not be factorised, even after adding jitter.
+    #[error(
+        "kernel matrix ({n}x{n}) is not positive definite even with jitter {jitter:e} added to its diagonal; \
+         the inputs may contain duplicate points and the noise variance may be too small"
+    )]
+    NotPositiveDefinite {
+        /// Size of the matrix.
+        n: usize,
+        /// The largest jitter tried.
+        jitter: f64,
+    },
+}
+
+/// Result alias for the core.
+pub type Result<T> = std::result::Result<T, CoreError>;
+
+/// Fails with [`CoreError::NonFinite`] at the first NaN or infinity in `values`.
+pub fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(CoreError::NonFinite { what, index, value: values[index] }),
+        None => Ok(()),
+    }
+}
+
+/// Fails with [`CoreError::InvalidParameter`] unless `value` is finite and > 0.
+pub fn check_positive(name: &'static str, value: f64) -> Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(CoreError::InvalidParameter { name, value, reason: "must be finite and > 0" })
+    }
+}

@@ -1,0 +1,204 @@
+//! A fitted GP regression map (paper Eq. 4): the GPLVM decoder (latent → posture) and the
+//! out-of-sample encoder (posture → latent) are both a [`GpMap`].
+//!
+//! Points are the columns of a matrix: a NumPy `(N, q)` C-ordered array read as
+//! column-major `q×N` is exactly that, with no copy.
+
+use nalgebra::{DMatrix, DVector, DVectorViewMut};
+use rayon::prelude::*;
+
+use crate::error::{check_finite, CoreError, Result};
+use crate::kernel::{factorize, SeKernel};
+
+/// Predictive mean and variance of a GP fitted to (inputs, outputs), everything that can be
+/// pre-computed done once: the Cholesky factor `L` of `K` and `α = K⁻¹ (Y − mean)`.
+#[derive(Debug, Clone)]
+pub struct GpMap {
+    kernel: SeKernel,
+    inputs: DMatrix<f64>,
+    /// `αᵀ` (p×N), so the mean is one matrix–vector product.
+    alpha_t: DMatrix<f64>,
+    lower: DMatrix<f64>,
+    mean: DVector<f64>,
+    jitter: f64,
+}
+
+/// Reusable buffers for [`GpMap::predict_into`], so a prediction allocates nothing.
+#[derive(Debug, Clone)]
+pub struct PredictScratch {
+    kstar: DVector<f64>,
+    solved: DVector<f64>,
+}
+
+impl GpMap {
+    /// Fits the map: `inputs` is q×N, `outputs` p×N (one point per column). Outputs are
+    /// centred here and the mean is added back on prediction.
+    pub fn new(inputs: DMatrix<f64>, outputs: DMatrix<f64>, kernel: SeKernel) -> Result<Self> {
+        let n = inputs.ncols();
+        if n == 0 || inputs.nrows() == 0 {
+            return Err(CoreError::Empty { what: "inputs" });
+        }
+        if outputs.ncols() != n || outputs.nrows() == 0 {
+            return Err(CoreError::Shape {
+                what: "outputs",
+                expected: format!("({n}, p) with p >= 1"),
+                got: format!("({}, {})", outputs.ncols(), outputs.nrows()),
+            });
+        }
+        check_finite("inputs", inputs.as_slice())?;
+        check_finite("outputs", outputs.as_slice())?;
+        let mean = outputs.column_mean();
+        let centred_t = (&outputs - &mean * DMatrix::from_element(1, n, 1.0)).transpose();
+        let factor = factorize(kernel.matrix(&inputs))?;
+        let alpha_t = factor.cholesky.solve(&centred_t).transpose();
+        Ok(Self { kernel, inputs, alpha_t, lower: factor.cholesky.l(), mean, jitter: factor.jitter })
+    }
+
+    /// Input dimension q.
+    pub fn input_dim(&self) -> usize {
+        self.inputs.nrows()
+    }
+
+    /// Output dimension p.
+    pub fn output_dim(&self) -> usize {
+        self.alpha_t.nrows()
+    }
+
+    /// Number of training points N.
+    pub fn len(&self) -> usize {
+        self.inputs.ncols()
+    }
+
+    /// Always false: a map is never fitted to no points.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// The kernel it was fitted with.
+    pub fn kernel(&self) -> SeKernel {
+        self.kernel
+    }
+
+    /// Jitter that had to be added to `K`'s diagonal to factorise it (0 if none).
+    pub fn jitter(&self) -> f64 {
+        self.jitter
+    }
+
+    /// Fresh buffers for [`Self::predict_into`].
+    pub fn scratch(&self) -> PredictScratch {
+        PredictScratch { kstar: DVector::zeros(self.len()), solved: DVector::zeros(self.len()) }
+    }
+
+    /// Eq. 4 at one point `x` (length q): writes the mean `k*ᵀ K⁻¹ Y + mean` into `mean_out`
+    /// (length p) and returns the variance `k(x, x) − k*ᵀ K⁻¹ k*` (white noise included,
+    /// the same in every output dimension). Allocation-free; lengths are the caller's
+    /// contract (checked in debug builds).
+    pub fn predict_into(&self, x: &[f64], mean_out: &mut [f64], scratch: &mut PredictScratch) -> f64 {
+        debug_assert_eq!(x.len(), self.input_dim());
+        debug_assert_eq!(mean_out.len(), self.output_dim());
+        for (k, point) in scratch.kstar.iter_mut().zip(self.inputs.column_iter()) {
+            *k = self.kernel.se(x, point.as_slice());
+        }
+        let mut out = DVectorViewMut::from_slice(mean_out, self.output_dim());
+        out.copy_from(&self.mean);
+        out.gemv(1.0, &self.alpha_t, &scratch.kstar, 1.0);
+        scratch.solved.copy_from(&scratch.kstar);
+        self.lower.solve_lower_triangular_mut(&mut scratch.solved);
+        (self.kernel.prior_variance() - scratch.solved.norm_squared()).max(0.0)
+    }
+
+    /// Checks a batch of query points (q×M) before prediction.
+    pub fn check_queries(&self, queries: &DMatrix<f64>) -> Result<()> {
+        if queries.nrows() != self.input_dim() {
+            return Err(CoreError::Shape {
+                what: "query points",
+                expected: format!("(M, {})", self.input_dim()),
+                got: format!("({}, {})", queries.ncols(), queries.nrows()),
+            });
+        }
+        check_finite("query points", queries.as_slice())
+    }
+
+    /// Means (p×M) and variances (M) at the columns of `queries` (q×M), rows in parallel.
+    pub fn predict(&self, queries: &DMatrix<f64>) -> Result<(DMatrix<f64>, DVector<f64>)> {
+        self.check_queries(queries)?;
+        let p = self.output_dim();
+        let m = queries.ncols();
+        let mut means = DMatrix::zeros(p, m);
+        let mut variances = DVector::zeros(m);
+        means
+            .as_mut_slice()
+            .par_chunks_mut(p)
+            .zip(variances.as_mut_slice().par_iter_mut())
+            .enumerate()
+            .for_each_init(
+                || self.scratch(),
+                |scratch, (j, (mean_out, var_out))| {
+                    *var_out = self.predict_into(queries.column(j).as_slice(), mean_out, scratch);
+                },
+            );
+        Ok((means, variances))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn toy() -> GpMap {
+        let inputs = DMatrix::from_fn(2, 12, |i, j| ((j * 5 + i * 3) % 7) as f64 * 0.4 - 1.0 + 0.01 * j as f64);
+        let outputs = DMatrix::from_fn(3, 12, |i, j| (inputs[(0, j)] * (i + 1) as f64).sin() + inputs[(1, j)]);
+        GpMap::new(inputs, outputs, SeKernel::new([1.0, 0.5, 1e-4]).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn dense_formula_agrees() {
+        let gp = toy();
+        let k = gp.kernel.matrix(&gp.inputs);
+        let kinv = k.try_inverse().unwrap();
+        let x = [0.3, -0.2];
+        let kstar = DVector::from_iterator(gp.len(), gp.inputs.column_iter().map(|c| gp.kernel.se(&x, c.as_slice())));
+        let mut mean = vec![0.0; 3];
+        let var = gp.predict_into(&x, &mut mean, &mut gp.scratch());
+        let dense_var = gp.kernel.prior_variance() - (kstar.transpose() * &kinv * &kstar)[0];
+        assert!((var - dense_var).abs() < 1e-9, "{var} vs {dense_var}");
+        let y = gp.alpha_t.clone() * gp.kernel.matrix(&gp.inputs); // recovers centred outputs
+        let dense_mean = &y * &kinv * &kstar + &gp.mean;
+        for i in 0..3 {
+            assert!((mean[i] - dense_mean[i]).abs() < 1e-8);
+        }
+    }
+
+    #[test]
+    fn interpolates_training_points_with_low_variance() {
+        let gp = toy();
+        let x: Vec<f64> = gp.inputs.column(4).iter().copied().collect();
+        let mut mean = vec![0.0; 3];
+        let var = gp.predict_into(&x, &mut mean, &mut gp.scratch());
+        assert!(var < 2e-4, "variance at a training point {var}");
+        let far = gp.predict_into(&[50.0, 50.0], &mut mean, &mut gp.scratch());
+        assert!((far - gp.kernel.prior_variance()).abs() < 1e-12);
+        assert!((DVector::from_column_slice(&mean) - &gp.mean).norm() < 1e-12);
+    }
+
+    #[test]
+    fn batch_equals_single() {
+        let gp = toy();
+        let q = DMatrix::from_fn(2, 5, |i, j| (i as f64 - j as f64) * 0.3);
+        let (means, vars) = gp.predict(&q).unwrap();
+        for j in 0..5 {
+            let mut m = vec![0.0; 3];
+            let v = gp.predict_into(q.column(j).as_slice(), &mut m, &mut gp.scratch());
+            assert_eq!(v, vars[j]);
+            assert_eq!(m.as_slice(), means.column(j).as_slice());
+        }
+    }
+
+    #[test]
+    fn bad_queries_are_errors() {
+        let gp = toy();
+        assert!(matches!(gp.predict(&DMatrix::zeros(3, 1)), Err(CoreError::Shape { .. })));
+        let nan = DMatrix::from_element(2, 1, f64::NAN);
+        assert!(matches!(gp.predict(&nan), Err(CoreError::NonFinite { .. })));
+    }
+}

@@ -1,0 +1,142 @@
+//! Squared-exponential plus white-noise kernel (paper Eq. 2) and its Cholesky factor.
+
+use nalgebra::{Cholesky, DMatrix, Dyn};
+
+use crate::error::{check_positive, CoreError, Result};
+
+/// `k(a, b) = θ1 · exp(−‖a − b‖² / (2 θ2)) + θ3 · δ_ab` (paper Eq. 2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SeKernel {
+    /// θ1, the signal variance.
+    pub variance: f64,
+    /// θ2, the squared length-scale.
+    pub lengthscale_sq: f64,
+    /// θ3, the white-noise variance.
+    pub noise: f64,
+}
+
+impl SeKernel {
+    /// A kernel from `[θ1, θ2, θ3]`; each must be finite and > 0.
+    pub fn new(theta: [f64; 3]) -> Result<Self> {
+        check_positive("theta1 (signal variance)", theta[0])?;
+        check_positive("theta2 (squared length-scale)", theta[1])?;
+        check_positive("theta3 (noise variance)", theta[2])?;
+        Ok(Self { variance: theta[0], lengthscale_sq: theta[1], noise: theta[2] })
+    }
+
+    /// The parameters as `[θ1, θ2, θ3]`.
+    pub fn theta(&self) -> [f64; 3] {
+        [self.variance, self.lengthscale_sq, self.noise]
+    }
+
+    /// The smooth (squared-exponential) part between two distinct points.
+    #[inline]
+    pub fn se(&self, a: &[f64], b: &[f64]) -> f64 {
+        let r2: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
+        self.variance * (-0.5 * r2 / self.lengthscale_sq).exp()
+    }
+
+    /// `k(x, x)`, white noise included: the prior variance at any point.
+    pub fn prior_variance(&self) -> f64 {
+        self.variance + self.noise
+    }
+
+    /// The N×N kernel matrix of points given as the columns of `points` (q×N), noise on the diagonal.
+    pub fn matrix(&self, points: &DMatrix<f64>) -> DMatrix<f64> {
+        let n = points.ncols();
+        let mut k = DMatrix::zeros(n, n);
+        for j in 0..n {
+            k[(j, j)] = self.prior_variance();
+            for i in 0..j {
+                let v = self.se(points.column(i).as_slice(), points.column(j).as_slice());
+                k[(i, j)] = v;
+                k[(j, i)] = v;
+            }
+        }
+        k
+    }
+}
+
+/// A Cholesky factor together with the jitter that had to be added to get it.
+#[derive(Debug, Clone)]
+pub struct Factor {
+    /// The factorisation of `K + jitter · I`.
+    pub cholesky: Cholesky<f64, Dyn>,
+    /// The jitter added to the diagonal (0 when `K` factorised as it was).
+    pub jitter: f64,
+}
+
+/// Largest jitter tried, relative to the mean of the diagonal.
+pub const MAX_RELATIVE_JITTER: f64 = 1e-4;
+
+/// Factorises `k`, adding jitter `mean(diag) · 1e-10, 1e-9, …` up to
+/// [`MAX_RELATIVE_JITTER`] if plain Cholesky fails. The jitter used is reported in
+/// the result; if even the largest fails, [`CoreError::NotPositiveDefinite`].
+pub fn factorize(k: DMatrix<f64>) -> Result<Factor> {
+    let n = k.nrows();
+    if n == 0 {
+        return Err(CoreError::Empty { what: "kernel matrix" });
+    }
+    let scale = k.diagonal().mean().abs().max(f64::MIN_POSITIVE);
+    if let Some(cholesky) = Cholesky::new(k.clone()) {
+        return Ok(Factor { cholesky, jitter: 0.0 });
+    }
+    let mut relative = 1e-10;
+    while relative <= MAX_RELATIVE_JITTER * 1.000_001 {
+        let jitter = relative * scale;
+        let mut jittered = k.clone();
+        for i in 0..n {
+            jittered[(i, i)] += jitter;
+        }
+        if let Some(cholesky) = Cholesky::new(jittered) {
+            return Ok(Factor { cholesky, jitter });
+        }
+        relative *= 10.0;
+    }
+    Err(CoreError::NotPositiveDefinite { n, jitter: MAX_RELATIVE_JITTER * scale })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kernel() -> SeKernel {
+        SeKernel::new([1.3, 0.4, 0.01]).unwrap()
+    }
+
+    #[test]
+    fn matrix_is_symmetric_positive_definite() {
+        let pts = DMatrix::from_fn(2, 9, |i, j| ((i * 7 + j * 3) % 5) as f64 * 0.3 - j as f64 * 0.1);
+        let k = kernel().matrix(&pts);
+        assert_eq!(k, k.transpose());
+        let eig = k.clone().symmetric_eigen().eigenvalues;
+        assert!(eig.min() > 0.0, "smallest eigenvalue {}", eig.min());
+        assert_eq!(factorize(k).unwrap().jitter, 0.0);
+    }
+
+    #[test]
+    fn se_matches_formula() {
+        let k = kernel();
+        let v = k.se(&[0.0, 1.0], &[0.5, 0.0]);
+        assert!((v - 1.3 * (-(0.25 + 1.0) / 0.8f64).exp()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn duplicates_need_and_report_jitter() {
+        let k = DMatrix::from_element(4, 4, 1.0); // rank one: four identical points, no noise
+        let f = factorize(k).unwrap();
+        assert!(f.jitter > 0.0 && f.jitter <= MAX_RELATIVE_JITTER);
+    }
+
+    #[test]
+    fn indefinite_matrix_is_an_error() {
+        let k = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        assert!(matches!(factorize(k), Err(CoreError::NotPositiveDefinite { n: 2, .. })));
+    }
+
+    #[test]
+    fn rejects_non_positive_theta() {
+        assert!(SeKernel::new([1.0, 0.0, 0.1]).is_err());
+        assert!(SeKernel::new([1.0, 1.0, f64::NAN]).is_err());
+    }
+}

@@ -1,0 +1,100 @@
+//! Binding of `latent_core::gp` and `latent_core::gplvm`.
+
+use latent_core::{nll_grad, GpMap, SeKernel};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+
+use crate::convert::{fixed, points, to_points, to_vector};
+use crate::errors::{to_py, InvalidInputError};
+
+/// A fitted GP map (paper Eq. 4): predictive mean and variance from inputs to outputs.
+#[pyclass(name = "GpMap", module = "latentrl._native", frozen)]
+pub struct PyGpMap {
+    /// The core object, also handed to Rust loops without crossing into Python.
+    pub inner: GpMap,
+}
+
+#[pymethods]
+impl PyGpMap {
+    /// Fits the map to `inputs` (N, q) and `outputs` (N, p) with `theta` = (θ1, θ2, θ3).
+    #[new]
+    fn new(
+        py: Python<'_>,
+        inputs: PyReadonlyArray2<'_, f64>,
+        outputs: PyReadonlyArray2<'_, f64>,
+        theta: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<Self> {
+        let inputs = points("inputs", &inputs)?;
+        let outputs = points("outputs", &outputs)?;
+        let kernel = SeKernel::new(fixed::<3>("theta", &theta)?).map_err(to_py)?;
+        let inner = py.detach(|| GpMap::new(inputs, outputs, kernel)).map_err(to_py)?;
+        Ok(Self { inner })
+    }
+
+    /// Means (M, p) and variances (M,) at `queries` (M, q).
+    fn predict<'py>(
+        &self,
+        py: Python<'py>,
+        queries: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+        let queries = points("queries", &queries)?;
+        let (means, variances) = py.detach(|| self.inner.predict(&queries)).map_err(to_py)?;
+        Ok((to_points(py, means)?, to_vector(py, variances)))
+    }
+
+    /// Mean (p,) and variance at one point `x` (q,).
+    fn predict_one<'py>(&self, py: Python<'py>, x: PyReadonlyArray1<'py, f64>) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
+        let x: Vec<f64> = x.as_array().iter().copied().collect();
+        if x.len() != self.inner.input_dim() {
+            return Err(InvalidInputError::new_err(format!(
+                "x: expected shape ({},), got ({},)",
+                self.inner.input_dim(),
+                x.len()
+            )));
+        }
+        latent_core::error::check_finite("x", &x).map_err(to_py)?;
+        let mut mean = vec![0.0; self.inner.output_dim()];
+        let variance = self.inner.predict_into(&x, &mut mean, &mut self.inner.scratch());
+        Ok((PyArray1::from_vec(py, mean), variance))
+    }
+
+    /// Input dimension q.
+    #[getter]
+    fn input_dim(&self) -> usize {
+        self.inner.input_dim()
+    }
+
+    /// Output dimension p.
+    #[getter]
+    fn output_dim(&self) -> usize {
+        self.inner.output_dim()
+    }
+
+    /// Jitter added to the kernel matrix's diagonal to factorise it (0.0 if none).
+    #[getter]
+    fn jitter(&self) -> f64 {
+        self.inner.jitter()
+    }
+
+    /// (θ1, θ2, θ3).
+    #[getter]
+    fn theta(&self) -> [f64; 3] {
+        self.inner.kernel().theta()
+    }
+}
+
+/// GPLVM objective at `latent` (N, d) for centred `data` (N, D):
+/// returns (nll, dnll/dlatent (N, d), dnll/dlog_theta (3,), jitter).
+#[pyfunction]
+pub fn gplvm_nll_grad<'py>(
+    py: Python<'py>,
+    latent: PyReadonlyArray2<'py, f64>,
+    data: PyReadonlyArray2<'py, f64>,
+    log_theta: PyReadonlyArray1<'py, f64>,
+) -> PyResult<(f64, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, f64)> {
+    let latent = points("latent", &latent)?;
+    let data = points("data", &data)?;
+    let log_theta = fixed::<3>("log_theta", &log_theta)?;
+    let r = py.detach(|| nll_grad(&latent, &data, log_theta)).map_err(to_py)?;
+    Ok((r.nll, to_points(py, r.grad_latent)?, PyArray1::from_vec(py, r.grad_log_theta.to_vec()), r.jitter))
+}

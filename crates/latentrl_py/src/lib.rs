@@ -1,0 +1,17 @@
+//! `latentrl._native`: the module table. Each file converts one core module; nothing is decided here.
+#![allow(missing_docs)]
+
+mod convert;
+mod errors;
+mod gp;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    errors::register(m)?;
+    m.add_class::<gp::PyGpMap>()?;
+    m.add_function(wrap_pyfunction!(gp::gplvm_nll_grad, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,2 @@
+//! `sim`: the plants latentrl learns to control.
+#![warn(missing_docs)]
