@@ -1,0 +1,7 @@
+"""`python -m latentrl` is the `latentrl` command."""
+
+import sys
+
+from latentrl.cli import main
+
+sys.exit(main())

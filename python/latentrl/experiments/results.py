@@ -1,0 +1,102 @@
+"""Results files of a run (SPEC §5): metadata JSON and per-episode NPZ, written atomically."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import platform
+import subprocess
+import tempfile
+from collections.abc import Callable, Mapping
+from importlib import metadata
+from pathlib import Path
+from typing import Any, BinaryIO
+
+import numpy as np
+
+RESULTS_FORMAT = 1
+"""Version of the results layout; bumped when a file changes meaning."""
+
+
+def write_atomic(path: Path, write: Callable[[BinaryIO], None]) -> None:
+    """Writes `path` through `write(file)` into a temporary file beside it, then renames it into place."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            write(handle)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def write_json(path: Path, payload: Mapping[str, Any]) -> None:
+    """Atomic, indented JSON; NumPy scalars and arrays become plain numbers and lists."""
+    text = json.dumps(payload, indent=2, default=_to_plain, allow_nan=True)
+    write_atomic(path, lambda f: f.write(text.encode()))
+
+
+def write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
+    """Atomic compressed NPZ."""
+    write_atomic(path, lambda f: np.savez_compressed(f, **arrays))
+
+
+def read_json(path: Path) -> dict[str, Any]:
+    """A results JSON, or a ValueError naming the file if it is not one."""
+    try:
+        payload = json.loads(Path(path).read_text())
+    except json.JSONDecodeError as err:
+        raise ValueError(f"{path}: not valid JSON ({err})") from err
+    if not isinstance(payload, dict):
+        raise ValueError(f"{path}: expected a JSON object at the top level")
+    return payload
+
+
+def _to_plain(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return dataclasses.asdict(value)
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"cannot write {type(value).__name__} to JSON")
+
+
+def environment() -> dict[str, Any]:
+    """Package and dependency versions, git revision if known, Python, platform, threads."""
+    versions = {}
+    for name in ("latentrl", "numpy", "scipy", "matplotlib"):
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            versions[name] = None
+    return {
+        "results_format": RESULTS_FORMAT,
+        "versions": versions,
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "git_revision": _git_revision(),
+        "cpu_count": os.cpu_count(),
+        "rayon_threads": int(os.environ.get("RAYON_NUM_THREADS", 0)) or os.cpu_count(),
+    }
+
+
+def _git_revision() -> str | None:
+    try:
+        out = subprocess.run(
+            ["git", "rev-parse", "HEAD"],
+            cwd=Path(__file__).resolve().parent,
+            capture_output=True,
+            text=True,
+            timeout=5,
+            check=True,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None
