@@ -1,13 +1,14 @@
 //! Python exception classes and the single mapping from core errors to them.
 
 use latent_core::CoreError;
+use ::sim::SimError;
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-create_exception!(_native, LatentrlError, PyValueError, "Base class of latentrl's errors (a ValueError).");
-create_exception!(_native, InvalidInputError, LatentrlError, "An argument had the wrong shape, a non-finite value or an impossible value.");
-create_exception!(_native, NumericalError, LatentrlError, "A computation could not be carried out stably (e.g. a kernel matrix not positive definite).");
+create_exception!(latentrl._native, LatentrlError, PyValueError, "Base class of latentrl's errors (a ValueError).");
+create_exception!(latentrl._native, InvalidInputError, LatentrlError, "An argument had the wrong shape, a non-finite value or an impossible value.");
+create_exception!(latentrl._native, NumericalError, LatentrlError, "A computation could not be carried out stably (e.g. a kernel matrix not positive definite).");
 
 /// Converts a core error into its Python exception; the message says what and where.
 pub fn to_py(err: CoreError) -> PyErr {
@@ -16,8 +17,20 @@ pub fn to_py(err: CoreError) -> PyErr {
         CoreError::Shape { .. }
         | CoreError::NonFinite { .. }
         | CoreError::Empty { .. }
-        | CoreError::InvalidParameter { .. } => InvalidInputError::new_err(msg),
+        | CoreError::InvalidParameter { .. }
+        | CoreError::NoValidStart { .. } => InvalidInputError::new_err(msg),
         CoreError::NotPositiveDefinite { .. } => NumericalError::new_err(msg),
+    }
+}
+
+/// Converts a plant error into its Python exception: every `sim` error is bad input.
+pub fn sim_to_py(err: SimError) -> PyErr {
+    let msg = err.to_string();
+    match err {
+        SimError::Shape { .. }
+        | SimError::NonFinite { .. }
+        | SimError::InvalidParameter { .. }
+        | SimError::Unreachable { .. } => InvalidInputError::new_err(msg),
     }
 }
 

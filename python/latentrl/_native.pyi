@@ -1,0 +1,74 @@
+"""Stubs of the Rust extension `latentrl._native` (hand-written; checked by mypy.stubtest)."""
+
+from typing import final
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "GpMap",
+    "InvalidInputError",
+    "LatentrlError",
+    "NumericalError",
+    "__version__",
+    "arms_elbows",
+    "arms_fk",
+    "arms_ik",
+    "gplvm_nll_grad",
+]
+
+__version__: str
+
+class LatentrlError(ValueError):
+    """Base class of latentrl's errors (a ValueError)."""
+
+class InvalidInputError(LatentrlError):
+    """An argument had the wrong shape, a non-finite value or an impossible value."""
+
+class NumericalError(LatentrlError):
+    """A computation could not be carried out stably
+    (e.g. a kernel matrix not positive definite)."""
+
+@final
+class GpMap:
+    """A fitted GP map (paper Eq. 4): predictive mean and variance from inputs to outputs."""
+
+    def __new__(
+        cls, inputs: NDArray[np.float64], outputs: NDArray[np.float64], theta: NDArray[np.float64]
+    ) -> GpMap:
+        """Fits the map to `inputs` (N, q) and `outputs` (N, p) with `theta` = (θ1, θ2, θ3)."""
+    def predict(
+        self, queries: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Means (M, p) and variances (M,) at `queries` (M, q)."""
+    def predict_one(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+        """Mean (p,) and variance at one point `x` (q,)."""
+    @property
+    def input_dim(self) -> int:
+        """Input dimension q."""
+    @property
+    def output_dim(self) -> int:
+        """Output dimension p."""
+    @property
+    def jitter(self) -> float:
+        """Jitter added to the kernel matrix's diagonal to factorise it (0.0 if none)."""
+    @property
+    def theta(self) -> list[float]:
+        """(θ1, θ2, θ3)."""
+
+def gplvm_nll_grad(
+    latent: NDArray[np.float64], data: NDArray[np.float64], log_theta: NDArray[np.float64]
+) -> tuple[float, NDArray[np.float64], NDArray[np.float64], float]:
+    """GPLVM objective at `latent` (N, d) for centred `data` (N, D):
+    returns (nll, dnll/dlatent (N, d), dnll/dlog_theta (3,), jitter)."""
+
+def arms_fk(postures: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Hands `(N, 4)` `[x_L, y_L, x_R, y_R]` of postures `(N, 4)` `[q1_L, q2_L, q1_R, q2_R]`
+    (default geometry: shoulders (±0.15, 0), links 0.3 + 0.3 m)."""
+
+def arms_elbows(postures: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Elbows `(N, 4)` `[x_L, y_L, x_R, y_R]` of postures `(N, 4)` (for drawing)."""
+
+def arms_ik(hands: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Postures `(N, 4)` (elbows outward, shoulder angles continuous in front of the body) that
+    put the hands at `hands` `(N, 4)`; an unreachable row raises InvalidInputError."""

@@ -1,0 +1,53 @@
+"""Plain-NumPy reference versions of the GP maths (dense, with `np.linalg`): the SE kernel
+(paper Eq. 2), GP prediction (Eq. 4) and the GPLVM objective and gradient (Eq. 1, 3).
+Tests check the Rust core against them; benches use them as the baseline."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+Array = NDArray[np.float64]
+
+
+def se_kernel(a: Array, b: Array, theta: Array) -> Array:
+    """`θ1 exp(−‖a_i − b_j‖² / (2 θ2))` between the rows of `a` (N, q) and `b` (M, q): (N, M)."""
+    r2 = np.sum((a[:, None, :] - b[None, :, :]) ** 2, axis=-1)
+    return theta[0] * np.exp(-0.5 * r2 / theta[1])
+
+
+def kernel_matrix(points: Array, theta: Array) -> Array:
+    """`K` of Eq. 2 over the rows of `points`: SE part plus `θ3 I`."""
+    return se_kernel(points, points, theta) + theta[2] * np.eye(len(points))
+
+
+def gp_predict(inputs: Array, outputs: Array, theta: Array, queries: Array) -> tuple[Array, Array]:
+    """Eq. 4: means (M, p) and variances (M,) at `queries` of the GP fitted to (inputs, outputs),
+    outputs centred and the mean added back, variance including θ3."""
+    mean = outputs.mean(axis=0)
+    k_inv = np.linalg.inv(kernel_matrix(inputs, theta))
+    k_star = se_kernel(queries, inputs, theta)
+    means = k_star @ k_inv @ (outputs - mean) + mean
+    variances = theta[0] + theta[2] - np.einsum("mi,ij,mj->m", k_star, k_inv, k_star)
+    return means, variances
+
+
+def gplvm_nll_grad(latent: Array, centred: Array, log_theta: Array) -> tuple[float, Array, Array]:
+    """Eq. 1/3: `L = (D/2) log|K| + ½ tr(K⁻¹ Y Yᵀ) + (N D/2) log 2π` and its gradient with
+    respect to `latent` (N, d) and `log θ` (3,), through `∂L/∂K = ½(D K⁻¹ − K⁻¹ Y Yᵀ K⁻¹)`."""
+    theta = np.exp(log_theta)
+    n, dims = centred.shape
+    k = kernel_matrix(latent, theta)
+    k_inv = np.linalg.inv(k)
+    log_det = np.linalg.slogdet(k)[1]
+    yyt = centred @ centred.T
+    nll = 0.5 * dims * log_det + 0.5 * np.trace(k_inv @ yyt) + 0.5 * n * dims * np.log(2 * np.pi)
+    g = 0.5 * (dims * k_inv - k_inv @ yyt @ k_inv)
+    k_se = se_kernel(latent, latent, theta)
+    diff = latent[:, None, :] - latent[None, :, :]
+    r2 = np.sum(diff**2, axis=-1)
+    grad_latent = -2.0 / theta[1] * np.einsum("ij,ijk->ik", g * k_se, diff)
+    grad_log_theta = np.array(
+        [np.sum(g * k_se), np.sum(g * k_se * r2) / (2 * theta[1]), theta[2] * np.trace(g)]
+    )
+    return float(nll), grad_latent, grad_log_theta

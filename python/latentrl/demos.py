@@ -1,0 +1,207 @@
+"""Demonstrated postures with their joint names, read from and written to CSV, NPZ or JSON.
+
+Formats (by extension):
+
+- ``.csv``: a header row of joint names, then one posture per row.
+- ``.npz``: arrays ``postures`` (N, D) and ``joint_names`` (D,) of strings.
+- ``.json``: ``{"joint_names": [...], "postures": [[...], ...]}``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl._base import PathLike, atomic_write, read_npz
+
+
+@dataclass(frozen=True, eq=False)
+class Demonstrations:
+    """Demonstrated postures (N, D), one column per joint, and the joints' names (D,).
+
+    Checked on construction: names non-empty and unique, at least one posture, one column
+    per name, every value finite. `postures` is stored as a read-only float64 copy.
+    """
+
+    postures: NDArray[np.float64]
+    joint_names: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        names = tuple(self.joint_names)
+        if not all(isinstance(name, str) and name.strip() for name in names):
+            raise ValueError(f"joint_names: every name must be a non-empty string, got {names}")
+        duplicates = sorted({name for name in names if names.count(name) > 1})
+        if duplicates:
+            raise ValueError(f"joint_names: duplicate joint names {duplicates}")
+        postures = np.array(self.postures, dtype=np.float64)
+        if postures.ndim != 2 or postures.shape[0] == 0:
+            raise ValueError(
+                f"postures: expected a 2-D array of at least one posture, "
+                f"got shape {postures.shape}"
+            )
+        if postures.shape[1] != len(names):
+            raise ValueError(f"postures: {postures.shape[1]} columns for {len(names)} joint names")
+        bad = np.argwhere(~np.isfinite(postures))
+        if bad.size:
+            i, j = bad[0]
+            raise ValueError(f"posture {i}, joint {names[j]!r}: non-finite value {postures[i, j]}")
+        postures.flags.writeable = False
+        object.__setattr__(self, "postures", postures)
+        object.__setattr__(self, "joint_names", names)
+
+    def __repr__(self) -> str:
+        return f"Demonstrations({self.postures.shape[0]} postures of {list(self.joint_names)})"
+
+
+def _number(cell: Any, where: str) -> float:
+    if isinstance(cell, (int, float, str)) and not isinstance(cell, bool):
+        try:
+            return float(cell)
+        except ValueError:
+            pass
+    raise ValueError(f"{where}: {cell!r} is not a number")
+
+
+def _table(rows: Sequence[tuple[str, Sequence[Any]]], names: Sequence[str]) -> NDArray[np.float64]:
+    """(label, cells) rows → (N, D) floats; ragged rows and non-numbers named by label and joint."""
+    values = np.empty((len(rows), len(names)))
+    for i, (label, cells) in enumerate(rows):
+        if len(cells) != len(names):
+            raise ValueError(f"{label}: {len(cells)} values, expected {len(names)} (one per joint)")
+        for j, cell in enumerate(cells):
+            values[i, j] = _number(cell, f"{label}, joint {names[j]!r}")
+    return values
+
+
+def _read_csv(path: Path) -> Demonstrations:
+    with open(path, newline="", encoding="utf-8-sig") as fh:
+        reader = csv.reader(fh)
+        lines = [(reader.line_num, row) for row in reader if row]
+    if not lines:
+        raise ValueError("empty file (no header row)")
+    (_, header), body = lines[0], lines[1:]
+    names = [name.strip() for name in header]
+    rows = [(f"line {line} (posture {i})", row) for i, (line, row) in enumerate(body)]
+    return Demonstrations(_table(rows, names), tuple(names))
+
+
+def _read_json(path: Path) -> Demonstrations:
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as err:
+        raise ValueError(f"not valid JSON: {err}") from err
+    if not isinstance(doc, dict) or not {"joint_names", "postures"} <= doc.keys():
+        raise ValueError('expected an object with keys "joint_names" and "postures"')
+    names, postures = doc["joint_names"], doc["postures"]
+    if not isinstance(names, list) or not isinstance(postures, list):
+        raise ValueError('"joint_names" and "postures" must be lists')
+    for i, row in enumerate(postures):
+        if not isinstance(row, list):
+            raise ValueError(f"posture {i}: expected a list of numbers, got {row!r}")
+    rows = [(f"posture {i}", row) for i, row in enumerate(postures)]
+    return Demonstrations(_table(rows, names), tuple(names))
+
+
+def _read_npz(path: Path) -> Demonstrations:
+    arrays = read_npz(path)
+    missing = sorted({"postures", "joint_names"} - arrays.keys())
+    if missing:
+        raise ValueError(f"missing arrays {missing}")
+    postures, names = arrays["postures"], arrays["joint_names"]
+    if postures.dtype.kind not in "iuf":
+        raise ValueError(f"postures: expected numbers, got dtype {postures.dtype}")
+    if names.dtype.kind != "U" or names.ndim != 1:
+        raise ValueError(
+            "joint_names: expected a 1-D array of strings, "
+            f"got dtype {names.dtype} shape {names.shape}"
+        )
+    return Demonstrations(postures, tuple(str(name) for name in names))
+
+
+def _write_csv(demos: Demonstrations, fh: IO[bytes]) -> None:
+    text = io.StringIO(newline="")
+    writer = csv.writer(text, lineterminator="\n")
+    writer.writerow(demos.joint_names)
+    writer.writerows(demos.postures.tolist())
+    fh.write(text.getvalue().encode("utf-8"))
+
+
+def _write_json(demos: Demonstrations, fh: IO[bytes]) -> None:
+    doc = {"joint_names": list(demos.joint_names), "postures": demos.postures.tolist()}
+    fh.write(json.dumps(doc, indent=1).encode("utf-8"))
+
+
+def _write_npz(demos: Demonstrations, fh: IO[bytes]) -> None:
+    np.savez(fh, postures=demos.postures, joint_names=np.array(demos.joint_names, dtype=str))
+
+
+_FORMATS: dict[
+    str, tuple[Callable[[Path], Demonstrations], Callable[[Demonstrations, IO[bytes]], None]]
+] = {
+    ".csv": (_read_csv, _write_csv),
+    ".json": (_read_json, _write_json),
+    ".npz": (_read_npz, _write_npz),
+}
+
+
+def _format(
+    path: Path,
+) -> tuple[Callable[[Path], Demonstrations], Callable[[Demonstrations, IO[bytes]], None]]:
+    try:
+        return _FORMATS[path.suffix.lower()]
+    except KeyError:
+        raise ValueError(
+            f"{path}: unsupported extension {path.suffix!r}; expected one of {', '.join(_FORMATS)}"
+        ) from None
+
+
+def _select(demos: Demonstrations, expected: Sequence[str]) -> Demonstrations:
+    missing = [name for name in expected if name not in demos.joint_names]
+    unknown = [name for name in demos.joint_names if name not in expected]
+    if missing or unknown:
+        raise ValueError(
+            f"joint names do not match the expected ones: missing {missing}, unknown {unknown}"
+        )
+    columns = [demos.joint_names.index(name) for name in expected]
+    return Demonstrations(demos.postures[:, columns], tuple(expected))
+
+
+def load_demos(
+    path: PathLike, *, expected_joints: Sequence[str] | None = None, min_postures: int = 1
+) -> Demonstrations:
+    """Reads demonstrations from a ``.csv``, ``.npz`` or ``.json`` file.
+
+    With `expected_joints`, the file must name exactly those joints, and the columns are
+    returned in that order. Fewer than `min_postures` postures is an error. Every problem
+    is a ValueError naming the file and what is wrong where.
+    """
+    path = Path(path)
+    read, _ = _format(path)
+    if path.stat().st_size == 0:
+        raise ValueError(f"{path}: empty file")
+    try:
+        demos = read(path)
+        if expected_joints is not None:
+            demos = _select(demos, tuple(expected_joints))
+    except ValueError as err:
+        raise ValueError(f"{path}: {err}") from err
+    if len(demos.postures) < min_postures:
+        raise ValueError(
+            f"{path}: {len(demos.postures)} postures, expected at least {min_postures}"
+        )
+    return demos
+
+
+def save_demos(demos: Demonstrations, path: PathLike) -> None:
+    """Writes `demos` to a ``.csv``, ``.npz`` or ``.json`` file (atomically)."""
+    path = Path(path)
+    _, write = _format(path)
+    atomic_write(path, lambda fh: write(demos, fh))

@@ -1,0 +1,209 @@
+"""The GPLVM (Lawrence 2005) as in the paper (SPEC §2.2): a latent space whose GP map
+decodes to the demonstrated postures, with two inverse maps to encode."""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl._base import Estimator, SavedSpec, initial_log_theta, minimise_nll
+from latentrl._native import GpMap
+from latentrl._validation import as_matrix, positive
+from latentrl.inverse import Projection, fit_gp_encoder
+from latentrl.pca import PCA, check_n_components
+
+ENCODERS = ("gp", "projection")
+
+#: Standard deviation of the perturbation of the (unit-scaled) PCA start for each restart.
+RESTART_SCALE = 0.5
+
+
+def _check_int(name: str, value: Any, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"{name} must be an int >= {minimum}, got {value!r}")
+    return int(value)
+
+
+class GPLVM(Estimator):
+    """Gaussian-process latent variable model with an SE + white-noise kernel (paper Eq. 2).
+
+    `fit` centres the postures, starts Z from PCA (scaled so the first latent axis has unit
+    variance) and minimises the negative log-likelihood (Eq. 1, 3) jointly over Z and log θ
+    with L-BFGS-B and the analytic gradient of the Rust core. Then it fits the
+    out-of-sample GP encoder.
+
+    Parameters
+    ----------
+    n_components : int, default=2
+        Latent dimension d.
+    max_iter : int, default=1000
+        L-BFGS-B iteration cap per start. If it is hit, `converged_` is False.
+    noise_floor : float, default=1e-6
+        Lower bound on θ3, the white-noise variance (units of the postures, squared). On
+        noise-free demonstrations the likelihood has no finite optimum (θ3 → 0); the
+        floor gives it one. Also the floor of the GP encoder's noise.
+    latent_prior : bool, default=False
+        Add a unit-Gaussian prior on Z (½‖Z‖² in the objective), as Lawrence's toolbox.
+    n_restarts : int, default=0
+        Extra starts, each the PCA start plus N(0, 0.5²) noise drawn from `random_state`;
+        the fit with the lowest objective is kept.
+    random_state : int or None, default=None
+        Seed of the restarts' perturbations.
+    encoder : {"gp", "projection"}, default="gp"
+        Default inverse map of `transform`.
+    tol : float, default=1e-6
+        L-BFGS-B stops when the relative decrease of the objective (ftol) or the largest
+        projected gradient component (gtol) falls below `tol` (scipy's `tol`).
+
+    Attributes
+    ----------
+    Z_ : ndarray (N, d)
+        Latent points of the training postures.
+    theta_ : ndarray (3,)
+        Kernel parameters θ1 (signal variance), θ2 (squared length-scale), θ3 (noise).
+    nll_ : float
+        Final objective: Eq. 1 NLL, plus ½‖Z‖² with `latent_prior`.
+    log_likelihood_ : float
+        −`nll_`.
+    n_iter_ : int
+        L-BFGS-B iterations of the kept start.
+    converged_ : bool
+        False if the kept start stopped at `max_iter`, or on a failed line search (often
+        the limit of floating-point precision; see `stop_reason_`).
+    stop_reason_ : str
+        L-BFGS-B's message for the kept start.
+    jitter_ : float
+        Jitter added to K's diagonal to factorise it at the optimum (0 if none).
+    mean_ : ndarray (D,)
+        Mean posture (added back on decoding).
+    X_train_ : ndarray (N, D)
+        The training postures.
+    encoder_theta_ : ndarray (3,)
+        θ of the out-of-sample GP encoder.
+    decoder_ : GpMap
+        Z → posture (Eq. 4).
+    encoder_ : GpMap
+        Posture → Z, the out-of-sample GP encoder.
+    projection_ : Projection
+        Posture → Z by iterative projection.
+    n_features_in_ : int
+        Number of joints D.
+    """
+
+    _saved: ClassVar[SavedSpec] = {
+        "n_features_in_": ("i", ()),
+        "mean_": ("f", ("D",)),
+        "X_train_": ("f", ("N", "D")),
+        "Z_": ("f", ("N", "d")),
+        "theta_": ("f", (3,)),
+        "encoder_theta_": ("f", (3,)),
+        "nll_": ("f", ()),
+        "n_iter_": ("i", ()),
+        "converged_": ("b", ()),
+        "stop_reason_": ("U", ()),
+        "jitter_": ("f", ()),
+    }
+
+    def __init__(
+        self,
+        n_components: int = 2,
+        max_iter: int = 1000,
+        noise_floor: float = 1e-6,
+        latent_prior: bool = False,
+        n_restarts: int = 0,
+        random_state: int | None = None,
+        encoder: str = "gp",
+        tol: float = 1e-6,
+    ) -> None:
+        self.n_components = n_components
+        self.max_iter = max_iter
+        self.noise_floor = noise_floor
+        self.latent_prior = latent_prior
+        self.n_restarts = n_restarts
+        self.random_state = random_state
+        self.encoder = encoder
+        self.tol = tol
+
+    def fit(self, X: Any, y: Any = None) -> GPLVM:
+        """Fits the latent points and kernel to postures `X` (N, D); returns self."""
+        X = as_matrix("X", X)
+        check_n_components(self.n_components, X)
+        max_iter = _check_int("max_iter", self.max_iter, 1)
+        n_restarts = _check_int("n_restarts", self.n_restarts, 0)
+        noise_floor = positive("noise_floor", self.noise_floor)
+        tol = positive("tol", self.tol)
+        self._check_encoder(self.encoder)
+
+        pca = PCA(self.n_components).fit(X)
+        start = pca.transform(X) / (np.sqrt(pca.explained_variance_[0]) or 1.0)
+        centred = X - pca.mean_
+        log_theta = initial_log_theta(start, centred)
+        rng = np.random.default_rng(self.random_state)
+        starts = [start] + [
+            start + RESTART_SCALE * rng.standard_normal(start.shape) for _ in range(n_restarts)
+        ]
+        fits = [
+            minimise_nll(
+                z0,
+                centred,
+                log_theta,
+                fit_latent=True,
+                latent_prior=bool(self.latent_prior),
+                noise_floor=noise_floor,
+                max_iter=max_iter,
+                tol=tol,
+            )
+            for z0 in starts
+        ]
+        best = min(fits, key=lambda fit: fit.nll)
+
+        self.n_features_in_ = X.shape[1]
+        self.mean_ = pca.mean_
+        self.X_train_ = X.copy()
+        self.Z_ = best.latent
+        self.theta_ = np.exp(best.log_theta)
+        self.nll_ = best.nll
+        self.n_iter_ = best.n_iter
+        self.converged_ = best.converged
+        self.stop_reason_ = best.message
+        self.jitter_ = best.jitter
+        encoder = fit_gp_encoder(X, self.Z_, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
+        self.encoder_theta_ = np.array(encoder.theta)
+        self._build()
+        return self
+
+    def _build(self) -> None:
+        self.log_likelihood_ = -self.nll_
+        self.decoder_ = GpMap(self.Z_, self.X_train_, self.theta_)
+        self.encoder_ = GpMap(self.X_train_, self.Z_, self.encoder_theta_)
+        self.projection_ = Projection(self.Z_, self.X_train_, self.theta_, self.decoder_.jitter)
+
+    @staticmethod
+    def _check_encoder(method: str) -> None:
+        if method not in ENCODERS:
+            raise ValueError(f"encoder method must be one of {ENCODERS}, got {method!r}")
+
+    def fit_transform(self, X: Any, y: Any = None) -> NDArray[np.float64]:
+        """`fit(X)`, then the fitted latent points `Z_` (not re-encoded)."""
+        return self.fit(X).Z_
+
+    def transform(self, X: Any, method: str | None = None) -> NDArray[np.float64]:
+        """Encodes postures `X` (M, D) to latent points (M, d), with the out-of-sample GP
+        (`method="gp"`) or the iterative projection; default: the `encoder` parameter."""
+        self._check_fitted()
+        method = self.encoder if method is None else method
+        self._check_encoder(method)
+        X = as_matrix("X", X, n_cols=self.n_features_in_)
+        return self.encoder_.predict(X)[0] if method == "gp" else self.projection_.encode(X)
+
+    def inverse_transform(self, Z: Any) -> NDArray[np.float64]:
+        """Decodes latent points `Z` (M, d) to postures (M, D): the GP mean (Eq. 4)."""
+        self._check_fitted()
+        return self.decoder_.predict(as_matrix("Z", Z, n_cols=self.n_components))[0]
+
+    def predict_variance(self, Z: Any) -> NDArray[np.float64]:
+        """Predictive variance σ²(z) (M,) at latent points `Z` (M, d), θ3 included (Eq. 4)."""
+        self._check_fitted()
+        return self.decoder_.predict(as_matrix("Z", Z, n_cols=self.n_components))[1]

@@ -1,0 +1,99 @@
+"""The two inverse maps posture → latent point (paper Sec. III-B, SPEC §2.2): the
+out-of-sample GP encoder (the paper's choice) and the iterative projection that checks it."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.linalg import cho_factor, cho_solve
+from scipy.optimize import minimize
+from scipy.spatial.distance import cdist
+
+from latentrl._base import initial_log_theta, minimise_nll
+from latentrl._native import GpMap
+from latentrl._reference import se_kernel
+
+Array = NDArray[np.float64]
+
+
+def fit_gp_encoder(
+    postures: Array,
+    latent: Array,
+    *,
+    noise_floor: float = 1e-6,
+    max_iter: int = 1000,
+    tol: float = 1e-6,
+) -> GpMap:
+    """GP regression from `postures` (N, D) to their `latent` points (N, d), SE kernel plus
+    noise, θ by maximising the marginal likelihood (L-BFGS-B over log θ, θ3 ≥ `noise_floor`).
+    Its predictive mean is the encoder."""
+    centred = latent - latent.mean(axis=0)
+    fit = minimise_nll(
+        postures,
+        centred,
+        initial_log_theta(postures, centred),
+        fit_latent=False,
+        latent_prior=False,
+        noise_floor=noise_floor,
+        max_iter=max_iter,
+        tol=tol,
+    )
+    return GpMap(postures, latent, np.exp(fit.log_theta))
+
+
+class Projection:
+    """Iterative projection: encodes `x` as `argmax_z log N(x | μ(z), σ²(z) I)` under the
+    decoder fitted to (`latent`, `postures`) with `theta`, by L-BFGS started from the latent
+    point of the nearest training posture (GPy's `infer_newX`). `jitter` is the decoder's."""
+
+    def __init__(
+        self,
+        latent: Array,
+        postures: Array,
+        theta: Array,
+        jitter: float = 0.0,
+        *,
+        max_iter: int = 200,
+    ):
+        self.latent = latent
+        self.postures = postures
+        self.theta = theta
+        self.max_iter = max_iter
+        self._mean = postures.mean(axis=0)
+        k = se_kernel(latent, latent, theta) + (theta[2] + jitter) * np.eye(len(latent))
+        self._factor = cho_factor(k, lower=True)
+        self._alpha = cho_solve(self._factor, postures - self._mean)
+
+    def decode_with_gradient(self, z: Array) -> tuple[Array, Array, float, Array]:
+        """Eq. 4 at `z` (d,): mean (D,), its Jacobian (D, d), variance, its gradient (d,)."""
+        diff = z - self.latent
+        k_star = se_kernel(z[None, :], self.latent, self.theta)[0]
+        dk_star = -k_star[:, None] * diff / self.theta[1]
+        solved = cho_solve(self._factor, k_star)
+        mean = self._mean + k_star @ self._alpha
+        variance = self.theta[0] + self.theta[2] - k_star @ solved
+        return mean, self._alpha.T @ dk_star, float(variance), -2.0 * solved @ dk_star
+
+    def neg_log_density(self, z: Array, x: Array) -> tuple[float, Array]:
+        """`−log N(x | μ(z), σ²(z) I)` and its gradient with respect to `z`."""
+        mean, d_mean, variance, d_variance = self.decode_with_gradient(z)
+        residual = x - mean
+        sq = residual @ residual
+        value = 0.5 * len(x) * np.log(2 * np.pi * variance) + 0.5 * sq / variance
+        grad = (
+            0.5 * len(x) / variance - 0.5 * sq / variance**2
+        ) * d_variance - residual @ d_mean / variance
+        return float(value), grad
+
+    def encode(self, X: Array) -> Array:
+        """Latent points (M, d) of postures `X` (M, D)."""
+        starts = self.latent[cdist(X, self.postures, "sqeuclidean").argmin(axis=1)]
+        latent = [self._maximise(x, z0) for x, z0 in zip(X, starts)]
+        return np.array(latent).reshape(len(X), self.latent.shape[1])
+
+    def _maximise(self, x: Array, z0: Array) -> Array:
+        options = {"maxiter": self.max_iter}
+        res = minimize(
+            self.neg_log_density, z0, args=(x,), jac=True, method="L-BFGS-B", options=options
+        )
+        return np.asarray(res.x)

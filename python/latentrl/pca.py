@@ -1,0 +1,98 @@
+"""PCA, the linear baseline (SPEC §2.1): fit on centred postures by SVD."""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl._base import Estimator, SavedSpec
+from latentrl._validation import as_matrix
+
+
+def check_n_components(n_components: Any, X: NDArray[np.float64]) -> int:
+    """`n_components` if it is an int with `n_components < n_samples` and `≤ n_features`."""
+    if (
+        isinstance(n_components, bool)
+        or not isinstance(n_components, (int, np.integer))
+        or n_components < 1
+    ):
+        raise ValueError(f"n_components must be an int >= 1, got {n_components!r}")
+    n_samples, n_features = X.shape
+    if n_samples <= n_components:
+        raise ValueError(
+            f"X: n_samples={n_samples} must be greater than n_components={n_components}"
+        )
+    if n_features < n_components:
+        raise ValueError(f"X: n_features={n_features} must be at least n_components={n_components}")
+    return int(n_components)
+
+
+class PCA(Estimator):
+    """Principal component analysis of postures.
+
+    Parameters
+    ----------
+    n_components : int, default=2
+        Dimension d of the latent space.
+
+    Attributes
+    ----------
+    mean_ : ndarray (D,)
+        Mean posture.
+    components_ : ndarray (d, D)
+        Principal axes, by decreasing variance; each axis's largest entry is positive.
+    explained_variance_ : ndarray (d,)
+        Variance of the data along each axis (denominator N − 1).
+    explained_variance_ratio_ : ndarray (d,)
+        Share of the total variance along each axis.
+    n_features_in_ : int
+        Number of joints D seen in `fit`.
+    """
+
+    _saved: ClassVar[SavedSpec] = {
+        "n_features_in_": ("i", ()),
+        "mean_": ("f", ("D",)),
+        "components_": ("f", ("d", "D")),
+        "explained_variance_": ("f", ("d",)),
+        "explained_variance_ratio_": ("f", ("d",)),
+    }
+
+    def __init__(self, n_components: int = 2) -> None:
+        self.n_components = n_components
+
+    def fit(self, X: Any, y: Any = None) -> PCA:
+        """Fits the principal axes of `X` (N, D); returns self."""
+        X = as_matrix("X", X)
+        d = check_n_components(self.n_components, X)
+        self.n_features_in_ = X.shape[1]
+        self.mean_ = X.mean(axis=0)
+        _, s, vt = np.linalg.svd(X - self.mean_, full_matrices=False)
+        axes = vt[:d]
+        self.components_ = (
+            axes * np.sign(axes[np.arange(d), np.argmax(np.abs(axes), axis=1)])[:, None]
+        )
+        variances = s**2 / (X.shape[0] - 1)
+        self.explained_variance_ = variances[:d]
+        total = variances.sum()
+        self.explained_variance_ratio_ = (
+            self.explained_variance_ / total if total > 0 else np.zeros(d)
+        )
+        return self
+
+    def transform(self, X: Any) -> NDArray[np.float64]:
+        """Latent points (N, d) of postures `X` (N, D)."""
+        self._check_fitted()
+        X = as_matrix("X", X, n_cols=self.n_features_in_)
+        return (X - self.mean_) @ self.components_.T
+
+    def fit_transform(self, X: Any, y: Any = None) -> NDArray[np.float64]:
+        """`fit(X)`, then `transform(X)`."""
+        return self.fit(X).transform(X)
+
+    def inverse_transform(self, Z: Any) -> NDArray[np.float64]:
+        """Postures (M, D) reconstructed from latent points `Z` (M, d)."""
+        self._check_fitted()
+        Z = as_matrix("Z", Z, n_cols=self.components_.shape[0])
+        return Z @ self.components_ + self.mean_

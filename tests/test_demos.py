@@ -1,0 +1,175 @@
+import json
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from latentrl import Demonstrations, load_demos, save_demos
+
+NAMES = ("shoulder_l", "elbow_l", "shoulder_r", "elbow_r")
+
+
+def demos(n=5):
+    return Demonstrations(np.random.default_rng(0).normal(size=(n, 4)), NAMES)
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npz", ".json"])
+def test_round_trip_is_exact(tmp_path, suffix):
+    original = demos()
+    save_demos(original, tmp_path / f"demos{suffix}")
+    loaded = load_demos(tmp_path / f"demos{suffix}")
+    np.testing.assert_array_equal(loaded.postures, original.postures)
+    assert loaded.joint_names == NAMES
+    assert [p.name for p in tmp_path.iterdir()] == [f"demos{suffix}"]  # no temporary file left
+
+
+@given(
+    arrays(
+        np.float64,
+        st.tuples(st.integers(1, 4), st.integers(1, 3)),
+        elements=st.floats(-1e300, 1e300),
+    )
+)
+def test_round_trip_any_finite_values(tmp_path_factory, postures):
+    directory = tmp_path_factory.mktemp("rt")
+    names = tuple(f"j,{i}" for i in range(postures.shape[1]))  # a comma, quoted in CSV
+    for suffix in (".csv", ".json", ".npz"):
+        save_demos(Demonstrations(postures, names), directory / f"d{suffix}")
+        loaded = load_demos(directory / f"d{suffix}")
+        np.testing.assert_array_equal(loaded.postures, postures)
+        assert loaded.joint_names == names
+
+
+def test_postures_are_a_read_only_copy():
+    source = np.zeros((2, 4))
+    d = Demonstrations(source, list(NAMES))
+    source[0, 0] = 1.0
+    assert d.postures[0, 0] == 0.0 and isinstance(d.joint_names, tuple)
+    with pytest.raises(ValueError, match="read-only"):
+        d.postures[0, 0] = 2.0
+    assert repr(d) == f"Demonstrations(2 postures of {list(NAMES)})"
+
+
+def test_expected_joints_reorder_columns(tmp_path):
+    save_demos(demos(), tmp_path / "d.csv")
+    reordered = load_demos(tmp_path / "d.csv", expected_joints=NAMES[::-1])
+    assert reordered.joint_names == NAMES[::-1]
+    np.testing.assert_array_equal(reordered.postures, demos().postures[:, ::-1])
+
+
+def test_csv_with_byte_order_mark_and_spaces(tmp_path):
+    path = tmp_path / "excel.csv"
+    path.write_bytes("\ufeffa, b\n1, 2.5\n".encode())
+    loaded = load_demos(path)
+    assert loaded.joint_names == ("a", "b")
+    np.testing.assert_array_equal(loaded.postures, [[1.0, 2.5]])
+
+
+def write(tmp_path, name, text):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "match"),
+    [
+        ("d.csv", "", "empty file"),
+        ("d.csv", "\n\n", "empty file"),
+        ("d.csv", "a,b\n", "at least one posture"),
+        ("d.csv", "a,b\n1,2\n3\n", r"line 3 \(posture 1\): 1 values, expected 2"),
+        ("d.csv", "a,b\n1,2\n3,x\n", r"line 3 \(posture 1\), joint 'b': 'x' is not a number"),
+        ("d.csv", "a,b\n1,2\n3,nan\n", "posture 1, joint 'b': non-finite value nan"),
+        ("d.csv", "a,b\ninf,2\n", "posture 0, joint 'a': non-finite value inf"),
+        ("d.csv", "a,b,a\n1,2,3\n", r"duplicate joint names \['a'\]"),
+        ("d.csv", "a,,c\n1,2,3\n", "every name must be a non-empty string"),
+        ("d.json", "{", "not valid JSON"),
+        ("d.json", '{"postures": [[1]]}', 'keys "joint_names" and "postures"'),
+        ("d.json", '{"joint_names": ["a"], "postures": 1}', "must be lists"),
+        (
+            "d.json",
+            '{"joint_names": ["a", "b"], "postures": [[1, 2], [3]]}',
+            "posture 1: 1 values, expected 2",
+        ),
+        (
+            "d.json",
+            '{"joint_names": ["a", "b"], "postures": [[1, 2], 3]}',
+            "posture 1: expected a list",
+        ),
+        (
+            "d.json",
+            '{"joint_names": ["a"], "postures": [[true]]}',
+            "posture 0, joint 'a': True is not a number",
+        ),
+        (
+            "d.json",
+            '{"joint_names": ["a"], "postures": [[null]]}',
+            "posture 0, joint 'a': None is not a number",
+        ),
+        (
+            "d.json",
+            '{"joint_names": ["a"], "postures": [[NaN]]}',
+            "posture 0, joint 'a': non-finite value nan",
+        ),
+        (
+            "d.json",
+            '{"joint_names": ["a", 2], "postures": [[1, 2]]}',
+            "every name must be a non-empty string",
+        ),
+        ("d.npz", "not a zip", "not a readable NPZ file"),
+        ("d.txt", "a,b\n1,2\n", "unsupported extension '.txt'; expected one of .csv, .json, .npz"),
+    ],
+)
+def test_bad_files_name_the_problem(tmp_path, name, text, match):
+    path = write(tmp_path, name, text)
+    with pytest.raises(ValueError, match=match) as info:
+        load_demos(path)
+    assert str(path) in str(info.value)
+
+
+def test_bad_npz_contents(tmp_path):
+    np.savez(tmp_path / "missing.npz", postures=np.ones((2, 2)))
+    with pytest.raises(ValueError, match=r"missing arrays \['joint_names'\]"):
+        load_demos(tmp_path / "missing.npz")
+    np.savez(
+        tmp_path / "text.npz", postures=np.array([["a", "b"]]), joint_names=np.array(["a", "b"])
+    )
+    with pytest.raises(ValueError, match="postures: expected numbers, got dtype <U1"):
+        load_demos(tmp_path / "text.npz")
+    np.savez(tmp_path / "names.npz", postures=np.ones((1, 2)), joint_names=np.array([1, 2]))
+    with pytest.raises(ValueError, match="joint_names: expected a 1-D array of strings"):
+        load_demos(tmp_path / "names.npz")
+    np.savez(tmp_path / "shape.npz", postures=np.ones((2, 3)), joint_names=np.array(["a", "b"]))
+    with pytest.raises(ValueError, match="postures: 3 columns for 2 joint names"):
+        load_demos(tmp_path / "shape.npz")
+
+
+def test_expected_joints_and_min_postures(tmp_path):
+    path = write(tmp_path, "d.csv", "a,b,c\n1,2,3\n4,5,6\n")
+    with pytest.raises(ValueError, match=r"missing \['d'\], unknown \['c'\]"):
+        load_demos(path, expected_joints=["a", "b", "d"])
+    with pytest.raises(ValueError, match=r"missing \[\], unknown \['c'\]"):
+        load_demos(path, expected_joints=["a", "b"])
+    with pytest.raises(ValueError, match="2 postures, expected at least 3"):
+        load_demos(path, min_postures=3)
+    assert load_demos(path, min_postures=2).postures.shape == (2, 3)
+    with pytest.raises(FileNotFoundError):
+        load_demos(tmp_path / "absent.csv")
+
+
+def test_save_rejects_unknown_extension_and_keeps_the_old_file_on_failure(tmp_path, monkeypatch):
+    with pytest.raises(ValueError, match=r"unsupported extension '\.yaml'"):
+        save_demos(demos(), tmp_path / "d.yaml")
+    path = tmp_path / "d.json"
+    save_demos(demos(2), path)
+    before = path.read_bytes()
+
+    def fail(*args, **kwargs):
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(json, "dumps", fail)
+    with pytest.raises(RuntimeError, match="disk full"):
+        save_demos(demos(7), path)
+    assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["d.json"]
