@@ -30,7 +30,15 @@ pub fn sim_to_py(err: SimError) -> PyErr {
         SimError::Shape { .. }
         | SimError::NonFinite { .. }
         | SimError::InvalidParameter { .. }
-        | SimError::Unreachable { .. } => InvalidInputError::new_err(msg),
+        | SimError::Unreachable { .. }
+        | SimError::MissingFile { .. }
+        | SimError::MalformedUrdf { .. }
+        | SimError::UnsupportedJointType { .. }
+        | SimError::UnsupportedGeometry { .. }
+        | SimError::UnknownJoint { .. }
+        | SimError::UnknownLink { .. }
+        | SimError::InvalidJointParameter { .. }
+        | SimError::UnknownObstacle { .. } => InvalidInputError::new_err(msg),
     }
 }
 

@@ -50,6 +50,81 @@ pub enum SimError {
         /// Largest reachable distance, `l1 + l2`.
         max: f64,
     },
+    /// A URDF file could not be read (missing, unreadable, not UTF-8).
+    #[error("cannot read URDF file {path}: {reason}")]
+    MissingFile {
+        /// The path as given.
+        path: String,
+        /// The operating-system error.
+        reason: String,
+    },
+    /// A URDF document is not well-formed XML or breaks the URDF schema.
+    #[error("malformed URDF ({origin}): {reason}")]
+    MalformedUrdf {
+        /// Where the document came from: a file path or `"<string>"`.
+        origin: String,
+        /// What was wrong, with the element's name where known.
+        reason: String,
+    },
+    /// A URDF joint has a type the physics plant does not support.
+    #[error(
+        "unsupported joint type {kind:?} for joint {joint:?} in {origin} \
+         (supported: revolute, continuous, prismatic, fixed)"
+    )]
+    UnsupportedJointType {
+        /// The joint's name.
+        joint: String,
+        /// The `type` attribute as written.
+        kind: String,
+        /// Where the document came from.
+        origin: String,
+    },
+    /// A URDF link uses a geometry the loader cannot build (meshes need cargo features).
+    #[error("unsupported {kind} geometry in link {link:?} of {origin}: use box, cylinder, capsule or sphere")]
+    UnsupportedGeometry {
+        /// The link's name.
+        link: String,
+        /// The geometry kind, e.g. `"mesh"`.
+        kind: &'static str,
+        /// Where the document came from.
+        origin: String,
+    },
+    /// A joint name that the robot does not have.
+    #[error("unknown joint {name:?}; actuated joints are: {known}")]
+    UnknownJoint {
+        /// The name asked for.
+        name: String,
+        /// Comma-separated list of the actuated joints, in URDF order.
+        known: String,
+    },
+    /// A link (or frame) name that the robot does not have.
+    #[error("unknown link {name:?}; links are: {known}")]
+    UnknownLink {
+        /// The name asked for.
+        name: String,
+        /// Comma-separated list of the links.
+        known: String,
+    },
+    /// A per-joint parameter was unusable (gain, torque cap, posture outside the limits).
+    #[error("invalid {name} = {value} for joint {joint:?}: {reason}")]
+    InvalidJointParameter {
+        /// The joint's name.
+        joint: String,
+        /// Parameter name (`"kp"`, `"kd"`, `"max_force"`, `"position"`, …).
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// What it must satisfy.
+        reason: String,
+    },
+    /// An obstacle id that was never returned by `add_obstacle`.
+    #[error("unknown obstacle id {id}; the world has {count} obstacles")]
+    UnknownObstacle {
+        /// The id asked for.
+        id: usize,
+        /// Number of obstacles in the world.
+        count: usize,
+    },
 }
 
 /// Result alias for the plants.

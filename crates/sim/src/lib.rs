@@ -1,2 +1,18 @@
 //! `sim`: the plants latentrl learns to control.
 #![warn(missing_docs)]
+
+pub mod bimanual;
+pub mod error;
+pub mod kinematics;
+pub mod obstacles;
+pub mod pd;
+pub mod plant;
+pub mod urdf;
+
+pub use bimanual::{BimanualConfig, BimanualLearner, BimanualPlant};
+pub use error::SimError;
+pub use kinematics::{ArmsPose, PlanarArms};
+pub use obstacles::{Contact, FallCriteria, FallStatus, Obstacle, ObstacleId, ObstacleShape};
+pub use pd::PdGains;
+pub use plant::{Frame, PhysicsSim, SimOptions};
+pub use urdf::{JointInfo, JointKind, RootMode, UrdfModel};

@@ -1,0 +1,266 @@
+//! [`PhysicsSim`]: a URDF robot in a rapier3d world, PD-servoed, stepped in RL steps.
+//!
+//! One RL step (SPEC §3.1 step 4) is: [`PhysicsSim::set_targets`] (the decoded posture),
+//! [`PhysicsSim::step_rl`] (`substeps` physics steps of `dt`), then read the reached
+//! posture ([`PhysicsSim::joint_positions`]), hand positions
+//! ([`PhysicsSim::frame_position`]) and contacts (`obstacles.rs`).
+//!
+//! Postures and targets are indexed in URDF joint order (actuated joints only); names
+//! map to indices with [`PhysicsSim::joint_index`]. rapier computes in f32; every value
+//! crossing this API is f64.
+
+use nalgebra::Isometry3;
+use rapier3d::prelude::{
+    ColliderBuilder, ColliderHandle, PhysicsWorld, Real, RigidBodyHandle, SharedShape, Vector,
+};
+
+use crate::error::{Result, SimError, check_finite};
+use crate::obstacles::ObstacleEntry;
+use crate::pd::{PdGains, drive, retarget};
+use crate::urdf::{JointSlot, RootMode, UrdfModel};
+
+mod options;
+mod readout;
+pub use options::SimOptions;
+pub use readout::Frame;
+
+/// A URDF robot in a rapier world with PD servos on every actuated joint.
+pub struct PhysicsSim {
+    pub(crate) world: PhysicsWorld,
+    pub(crate) model: UrdfModel,
+    pub(crate) options: SimOptions,
+    pub(crate) slots: Vec<JointSlot>,
+    pub(crate) gains: Vec<PdGains>,
+    pub(crate) targets: Vec<f64>,
+    pub(crate) frames: Vec<Option<(RigidBodyHandle, Isometry3<f64>)>>,
+    pub(crate) link_colliders: Vec<(usize, ColliderHandle)>,
+    pub(crate) root: RigidBodyHandle,
+    pub(crate) ground: Option<ColliderHandle>,
+    pub(crate) obstacles: Vec<ObstacleEntry>,
+    time: f64,
+}
+
+impl PhysicsSim {
+    /// Builds the world: every joint at zero (clamped into its limits), servos holding
+    /// that posture, optional ground.
+    pub fn new(model: UrdfModel, options: SimOptions) -> Result<Self> {
+        options.validate()?;
+        let mut world = PhysicsWorld::new();
+        let [gx, gy, gz] = options.gravity;
+        world.gravity = Vector::new(gx as Real, gy as Real, gz as Real);
+        world.integration_parameters.dt = options.dt as Real;
+        world.integration_parameters.num_solver_iterations = options.solver_iterations;
+        let robot = model.insert(&mut world, options.root, options.self_collisions)?;
+        let ground = options.ground.map(|z| {
+            let plane = ColliderBuilder::new(SharedShape::halfspace(Vector::Z))
+                .translation(Vector::new(0.0, 0.0, z as Real));
+            world.colliders.insert(plane)
+        });
+        let mut gains = Vec::with_capacity(model.joints().len());
+        for (info, slot) in model.joints().iter().zip(&robot.slots) {
+            let g = match (options.use_urdf_effort, info.effort) {
+                (true, Some(effort)) => options.gains.capped(effort),
+                _ => options.gains,
+            };
+            gains.push(g);
+            if let Some((mb, _)) = world.multibody_joints.get_mut(slot.handle) {
+                mb.damping_mut()[slot.dof] = info.damping.unwrap_or(options.joint_damping) as Real;
+                mb.frictions_mut()[slot.dof] = info.friction.unwrap_or(0.0) as Real;
+            }
+        }
+        let n = model.joints().len();
+        let start: Vec<f64> = model
+            .joints()
+            .iter()
+            .map(|j| 0.0_f64.clamp(j.lower, j.upper))
+            .collect();
+        let mut sim = Self {
+            world,
+            model,
+            options,
+            slots: robot.slots,
+            gains,
+            targets: vec![0.0; n],
+            frames: robot.frames,
+            link_colliders: robot.colliders,
+            root: robot.root,
+            ground,
+            obstacles: Vec::new(),
+            time: 0.0,
+        };
+        sim.reset(&start)?;
+        Ok(sim)
+    }
+
+    /// Loads a URDF file ([`UrdfModel::from_file`]) and builds the world.
+    pub fn from_urdf_file(path: impl AsRef<std::path::Path>, options: SimOptions) -> Result<Self> {
+        Self::new(UrdfModel::from_file(path)?, options)
+    }
+
+    /// The robot description.
+    pub fn model(&self) -> &UrdfModel {
+        &self.model
+    }
+
+    /// The options the world was built with.
+    pub fn options(&self) -> &SimOptions {
+        &self.options
+    }
+
+    /// Number of actuated joints (the length of postures and targets).
+    pub fn num_joints(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// Index of the actuated joint `name` in postures and targets.
+    pub fn joint_index(&self, name: &str) -> Result<usize> {
+        self.model.joint_index(name)
+    }
+
+    /// Simulated time since the last reset (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Duration of one RL step, `dt · substeps` (s).
+    pub fn rl_dt(&self) -> f64 {
+        self.options.dt * self.options.substeps as f64
+    }
+
+    fn check_posture(&self, what: &'static str, values: &[f64]) -> Result<()> {
+        if values.len() != self.slots.len() {
+            let expected = format!("({},)", self.slots.len());
+            return Err(SimError::Shape {
+                what,
+                expected,
+                got: format!("({},)", values.len()),
+            });
+        }
+        check_finite(what, values)
+    }
+
+    /// Teleports the robot to `posture` at rest (fixed root) and aims the servos at it.
+    ///
+    /// Multibody joints start at zero; this sets their coordinates, zeroes every
+    /// velocity, runs forward kinematics and moves the bodies (contact queries see the
+    /// new posture at once).
+    /// Fails on a wrong length, a non-finite value or a value outside the joint limits.
+    pub fn reset(&mut self, posture: &[f64]) -> Result<()> {
+        let base = self.base_pose();
+        self.reset_with_base(posture, &base)
+    }
+
+    /// [`PhysicsSim::reset`] that also places a floating root at `base` (ignored when fixed).
+    pub fn reset_with_base(&mut self, posture: &[f64], base: &Isometry3<f64>) -> Result<()> {
+        self.check_posture("posture", posture)?;
+        for (info, &q) in self.model.joints().iter().zip(posture) {
+            if q < info.lower || q > info.upper {
+                return Err(SimError::InvalidJointParameter {
+                    joint: info.name.clone(),
+                    name: "position",
+                    value: q,
+                    reason: format!("outside the joint limits [{}, {}]", info.lower, info.upper),
+                });
+            }
+        }
+        let floating = self.options.root == RootMode::Floating;
+        if floating && let Some(rb) = self.world.bodies.get_mut(self.root) {
+            rb.set_position(crate::obstacles::to_pose(base), true);
+        }
+        for (slot, &q) in self.slots.iter().zip(posture) {
+            if let Some((mb, _)) = self.world.multibody_joints.get_mut(slot.handle)
+                && let Some(link) = mb.link_mut(slot.link_id)
+            {
+                let current = link.joint.coords()[slot.axis as usize];
+                link.joint.apply_displacement(&[q as Real - current]);
+            }
+        }
+        for slot in &self.slots {
+            if let Some((mb, _)) = self.world.multibody_joints.get_mut(slot.handle) {
+                mb.generalized_velocity_mut().fill(0.0);
+                mb.forward_kinematics(&self.world.bodies, floating);
+                mb.update_rigid_bodies(&mut self.world.bodies, true);
+            }
+        }
+        for (_, rb) in self.world.bodies.iter_mut() {
+            rb.set_linvel(Vector::ZERO, true);
+            rb.set_angvel(Vector::ZERO, true);
+        }
+        for (i, slot) in self.slots.iter().enumerate() {
+            if let Some((mb, _)) = self.world.multibody_joints.get_mut(slot.handle)
+                && let Some(link) = mb.link_mut(slot.link_id)
+            {
+                drive(&mut link.joint.data, slot.axis, posture[i], &self.gains[i]);
+            }
+        }
+        self.targets.copy_from_slice(posture);
+        self.time = 0.0;
+        Ok(())
+    }
+
+    /// Sets every servo target (URDF joint order), clamped to the joint limits.
+    pub fn set_targets(&mut self, targets: &[f64]) -> Result<()> {
+        self.check_posture("targets", targets)?;
+        for (i, &t) in targets.iter().enumerate() {
+            self.write_target(i, t);
+        }
+        Ok(())
+    }
+
+    /// Sets the servo target of one joint by name, clamped to its limits.
+    pub fn set_target(&mut self, joint: &str, target: f64) -> Result<()> {
+        let i = self.model.joint_index(joint)?;
+        check_finite("target", &[target])?;
+        self.write_target(i, target);
+        Ok(())
+    }
+
+    fn write_target(&mut self, i: usize, target: f64) {
+        let info = &self.model.joints()[i];
+        let t = target.clamp(info.lower, info.upper);
+        self.targets[i] = t;
+        let slot = self.slots[i];
+        if let Some((mb, _)) = self.world.multibody_joints.get_mut(slot.handle)
+            && let Some(link) = mb.link_mut(slot.link_id)
+        {
+            retarget(&mut link.joint.data, slot.axis, t);
+        }
+    }
+
+    /// The current servo targets (after clamping).
+    pub fn targets(&self) -> &[f64] {
+        &self.targets
+    }
+
+    /// The gains of joint `i`.
+    pub fn gains(&self, i: usize) -> Option<&PdGains> {
+        self.gains.get(i)
+    }
+
+    /// Replaces the servo gains (and torque cap) of joint `joint` (by name).
+    pub fn set_gains(&mut self, joint: &str, gains: PdGains) -> Result<()> {
+        let i = self.model.joint_index(joint)?;
+        gains.validate(joint)?;
+        self.gains[i] = gains;
+        let slot = self.slots[i];
+        if let Some((mb, _)) = self.world.multibody_joints.get_mut(slot.handle)
+            && let Some(link) = mb.link_mut(slot.link_id)
+        {
+            drive(&mut link.joint.data, slot.axis, self.targets[i], &gains);
+        }
+        Ok(())
+    }
+
+    /// Advances the world by `n` physics steps of `dt`.
+    pub fn step(&mut self, n: usize) {
+        for _ in 0..n {
+            self.world.step();
+        }
+        self.time += n as f64 * self.options.dt;
+    }
+
+    /// Advances the world by one RL step (`substeps` physics steps).
+    pub fn step_rl(&mut self) {
+        self.step(self.options.substeps);
+    }
+}

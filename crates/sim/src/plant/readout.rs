@@ -1,0 +1,94 @@
+//! Reading the plant's state: joint positions and velocities, link poses and the world
+//! positions of frames such as the hands. Everything is widened from rapier's f32.
+
+use nalgebra::{Isometry3, Point3};
+use rapier3d::prelude::RigidBodyHandle;
+
+use super::PhysicsSim;
+use crate::error::{Result, SimError};
+use crate::urdf::{JointSlot, to_isometry};
+
+/// A point fixed on a link: where to read a hand position. Made by [`PhysicsSim::frame`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    pub(crate) body: RigidBodyHandle,
+    pub(crate) offset: Isometry3<f64>,
+}
+
+impl PhysicsSim {
+    /// Writes the joint positions (URDF order) into `out` (length `num_joints`).
+    pub fn joint_positions_into(&self, out: &mut [f64]) {
+        for (o, slot) in out.iter_mut().zip(&self.slots) {
+            *o = self
+                .world
+                .multibody_joints
+                .get(slot.handle)
+                .and_then(|(mb, _)| mb.link(slot.link_id))
+                .map_or(f64::NAN, |l| l.joint().coords()[slot.axis as usize] as f64);
+        }
+    }
+
+    /// The joint positions (rad or m), URDF order: the reached posture.
+    pub fn joint_positions(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.slots.len()];
+        self.joint_positions_into(&mut out);
+        out
+    }
+
+    /// The joint velocities (rad/s or m/s), URDF order.
+    pub fn joint_velocities(&self) -> Vec<f64> {
+        let vel = |slot: &JointSlot| {
+            let mb = self
+                .world
+                .multibody_joints
+                .get(slot.handle)
+                .map(|(mb, _)| mb);
+            mb.map_or(f64::NAN, |mb| mb.generalized_velocity()[slot.dof] as f64)
+        };
+        self.slots.iter().map(vel).collect()
+    }
+
+    /// A frame on link `link` (any URDF link, body-less hand frames included) shifted
+    /// by `offset` (metres, in the link frame).
+    pub fn frame(&self, link: &str, offset: [f64; 3]) -> Result<Frame> {
+        let i = self.model.link_index(link)?;
+        let (body, pose) = self.frames[i].ok_or_else(|| SimError::UnknownLink {
+            name: link.to_string(),
+            known: "links with a body or fixed to one".to_string(),
+        })?;
+        let shift = Isometry3::translation(offset[0], offset[1], offset[2]);
+        Ok(Frame {
+            body,
+            offset: pose * shift,
+        })
+    }
+
+    /// World pose of `frame`.
+    pub fn frame_pose(&self, frame: &Frame) -> Isometry3<f64> {
+        self.world
+            .bodies
+            .get(frame.body)
+            .map_or_else(Isometry3::identity, |rb| {
+                to_isometry(rb.position()) * frame.offset
+            })
+    }
+
+    /// World position of `frame` (e.g. a hand).
+    pub fn frame_position(&self, frame: &Frame) -> [f64; 3] {
+        let p = self.frame_pose(frame) * Point3::origin();
+        [p.x, p.y, p.z]
+    }
+
+    /// World pose of link `link` (its URDF link frame).
+    pub fn link_pose(&self, link: &str) -> Result<Isometry3<f64>> {
+        Ok(self.frame_pose(&self.frame(link, [0.0; 3])?))
+    }
+
+    /// World pose of the root link.
+    pub fn base_pose(&self) -> Isometry3<f64> {
+        self.world
+            .bodies
+            .get(self.root)
+            .map_or_else(Isometry3::identity, |rb| to_isometry(rb.position()))
+    }
+}

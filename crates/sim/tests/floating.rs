@@ -1,0 +1,91 @@
+//! A free-floating robot on the ground: root DoFs, reset of the base, contacts, fall test.
+use nalgebra::Isometry3;
+use sim::{FallCriteria, PhysicsSim, RootMode, SimOptions, UrdfModel};
+
+/// A 0.2 × 0.2 × 0.1 m block (1 kg) with a 0.3 m arm on a hinge about y at its top.
+const ROBOT: &str = r#"<robot name="block">
+  <link name="base">
+    <inertial><mass value="1"/><inertia ixx="4e-3" ixy="0" ixz="0" iyy="4e-3" iyz="0" izz="7e-3"/></inertial>
+    <collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision>
+  </link>
+  <link name="arm">
+    <inertial><origin xyz="0 0 0.15"/><mass value="0.2"/>
+      <inertia ixx="1.5e-3" ixy="0" ixz="0" iyy="1.5e-3" iyz="0" izz="1e-5"/></inertial>
+    <collision><origin xyz="0 0 0.15"/><geometry><capsule radius="0.01" length="0.28"/></geometry></collision>
+  </link>
+  <joint name="hinge" type="revolute">
+    <origin xyz="0 0 0.05"/><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/>
+    <limit lower="-1.5" upper="1.5" effort="50" velocity="5"/>
+  </joint>
+</robot>"#;
+
+fn block() -> PhysicsSim {
+    let options = SimOptions {
+        root: RootMode::Floating,
+        ground: Some(0.0),
+        ..SimOptions::default()
+    };
+    PhysicsSim::new(UrdfModel::parse(ROBOT).unwrap(), options).unwrap()
+}
+
+#[test]
+fn floating_block_falls_onto_the_ground_and_keeps_moving_its_arm() {
+    let mut sim = block();
+    assert_eq!(
+        sim.num_joints(),
+        1,
+        "the free root is not part of the posture"
+    );
+    sim.reset_with_base(&[0.0], &Isometry3::translation(0.1, -0.2, 0.3))
+        .unwrap();
+    let base = sim.base_pose().translation;
+    assert!(
+        (base.x - 0.1).abs() < 1e-6 && (base.z - 0.3).abs() < 1e-6,
+        "{base:?}"
+    );
+    assert!(!sim.touching_ground("base").unwrap());
+    sim.step(480);
+    let z = sim.base_pose().translation.z;
+    assert!(
+        (z - 0.05).abs() < 5e-3,
+        "the block rests on the ground: z = {z}"
+    );
+    assert!(sim.touching_ground("base").unwrap());
+    // Bodies never sleep: a new target after 2 s of rest still moves the arm.
+    sim.set_targets(&[0.5]).unwrap();
+    sim.step(60);
+    assert!(
+        (sim.joint_positions()[0] - 0.5).abs() < 0.05,
+        "{:?}",
+        sim.joint_positions()
+    );
+}
+
+#[test]
+fn fall_test_reads_base_height_tilt_and_ground_contacts() {
+    let mut sim = block();
+    sim.reset_with_base(&[0.0], &Isometry3::translation(0.0, 0.0, 0.3))
+        .unwrap();
+    sim.step(240);
+    let standing = FallCriteria {
+        min_base_height: 0.03,
+        max_sole_tilt: 0.35,
+        soles: vec!["base".into()],
+    };
+    let status = sim.fall_status(&standing).unwrap();
+    assert!(
+        !status.fell && status.sole_tilt < 0.05 && status.ground_contact.is_none(),
+        "{status:?}"
+    );
+    let strict = FallCriteria {
+        min_base_height: 0.1,
+        ..standing.clone()
+    };
+    assert!(sim.fall_status(&strict).unwrap().fell);
+    // A hard swing sideways tips the block: the arm (not a sole) hits the floor.
+    sim.set_targets(&[1.5]).unwrap();
+    sim.step(240);
+    let status = sim.fall_status(&standing).unwrap();
+    assert_eq!(status.ground_contact.as_deref(), Some("arm"), "{status:?}");
+    assert!(status.fell);
+}
