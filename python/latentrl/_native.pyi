@@ -41,6 +41,8 @@ class GpMap:
         self, queries: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Means (M, p) and variances (M,) at `queries` (M, q)."""
+    def predict_mean(self, queries: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Means only (M, p) at `queries` (M, q): no variance, several times faster."""
     def predict_one(self, x: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
         """Mean (p,) and variance at one point `x` (q,)."""
     @property

@@ -196,12 +196,12 @@ class GPLVM(Estimator):
         method = self.encoder if method is None else method
         self._check_encoder(method)
         X = as_matrix("X", X, n_cols=self.n_features_in_)
-        return self.encoder_.predict(X)[0] if method == "gp" else self.projection_.encode(X)
+        return self.encoder_.predict_mean(X) if method == "gp" else self.projection_.encode(X)
 
     def inverse_transform(self, Z: Any) -> NDArray[np.float64]:
         """Decodes latent points `Z` (M, d) to postures (M, D): the GP mean (Eq. 4)."""
         self._check_fitted()
-        return self.decoder_.predict(as_matrix("Z", Z, n_cols=self.n_components))[0]
+        return self.decoder_.predict_mean(as_matrix("Z", Z, n_cols=self.n_components))
 
     def predict_variance(self, Z: Any) -> NDArray[np.float64]:
         """Predictive variance σ²(z) (M,) at latent points `Z` (M, d), θ3 included (Eq. 4)."""

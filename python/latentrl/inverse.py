@@ -44,7 +44,13 @@ def fit_gp_encoder(
 class Projection:
     """Iterative projection: encodes `x` as `argmax_z log N(x | μ(z), σ²(z) I)` under the
     decoder fitted to (`latent`, `postures`) with `theta`, by L-BFGS started from the latent
-    point of the nearest training posture (GPy's `infer_newX`). `jitter` is the decoder's."""
+    point of the nearest training posture (GPy's `infer_newX`). `jitter` is the decoder's.
+
+    Two stages (ours): first the squared reconstruction error ½‖x − μ(z)‖², then the
+    density from there. Started on the density directly, L-BFGS leaves the data at once:
+    where σ² is tiny a small residual costs more than moving to where σ² is large. The
+    search stays inside the bounding box of the latent points widened by `margin` of its
+    extent per side, and the best of start and both stages (by density) is kept."""
 
     def __init__(
         self,
@@ -54,11 +60,15 @@ class Projection:
         jitter: float = 0.0,
         *,
         max_iter: int = 200,
+        margin: float = 0.5,
     ):
         self.latent = latent
         self.postures = postures
         self.theta = theta
         self.max_iter = max_iter
+        low, high = latent.min(axis=0), latent.max(axis=0)
+        pad = margin * (high - low)
+        self._bounds = list(zip(low - pad, high + pad))
         self._mean = postures.mean(axis=0)
         k = se_kernel(latent, latent, theta) + (theta[2] + jitter) * np.eye(len(latent))
         self._factor = cho_factor(k, lower=True)
@@ -85,6 +95,12 @@ class Projection:
         ) * d_variance - residual @ d_mean / variance
         return float(value), grad
 
+    def reconstruction_error(self, z: Array, x: Array) -> tuple[float, Array]:
+        """`½‖x − μ(z)‖²` and its gradient with respect to `z`."""
+        mean, d_mean, _, _ = self.decode_with_gradient(z)
+        residual = x - mean
+        return 0.5 * float(residual @ residual), -residual @ d_mean
+
     def encode(self, X: Array) -> Array:
         """Latent points (M, d) of postures `X` (M, D)."""
         starts = self.latent[cdist(X, self.postures, "sqeuclidean").argmin(axis=1)]
@@ -92,8 +108,16 @@ class Projection:
         return np.array(latent).reshape(len(X), self.latent.shape[1])
 
     def _maximise(self, x: Array, z0: Array) -> Array:
-        options = {"maxiter": self.max_iter}
-        res = minimize(
-            self.neg_log_density, z0, args=(x,), jac=True, method="L-BFGS-B", options=options
-        )
-        return np.asarray(res.x)
+        candidates = [z0]
+        for objective in (self.reconstruction_error, self.neg_log_density):
+            res = minimize(
+                objective,
+                candidates[-1],
+                args=(x,),
+                jac=True,
+                method="L-BFGS-B",
+                bounds=self._bounds,
+                options={"maxiter": self.max_iter},
+            )
+            candidates.append(np.asarray(res.x))
+        return min(candidates, key=lambda z: self.neg_log_density(z, x)[0])

@@ -94,6 +94,14 @@ impl GpMap {
     /// the same in every output dimension). Allocation-free; lengths are the caller's
     /// contract (checked in debug builds).
     pub fn predict_into(&self, x: &[f64], mean_out: &mut [f64], scratch: &mut PredictScratch) -> f64 {
+        self.mean_into(x, mean_out, scratch);
+        scratch.solved.copy_from(&scratch.kstar);
+        self.lower.solve_lower_triangular_mut(&mut scratch.solved);
+        (self.kernel.prior_variance() - scratch.solved.norm_squared()).max(0.0)
+    }
+
+    /// The mean half of [`Self::predict_into`]: `O(N (q + p))`, leaves `k*` in `scratch`.
+    pub fn mean_into(&self, x: &[f64], mean_out: &mut [f64], scratch: &mut PredictScratch) {
         debug_assert_eq!(x.len(), self.input_dim());
         debug_assert_eq!(mean_out.len(), self.output_dim());
         for (k, point) in scratch.kstar.iter_mut().zip(self.inputs.column_iter()) {
@@ -102,9 +110,6 @@ impl GpMap {
         let mut out = DVectorViewMut::from_slice(mean_out, self.output_dim());
         out.copy_from(&self.mean);
         out.gemv(1.0, &self.alpha_t, &scratch.kstar, 1.0);
-        scratch.solved.copy_from(&scratch.kstar);
-        self.lower.solve_lower_triangular_mut(&mut scratch.solved);
-        (self.kernel.prior_variance() - scratch.solved.norm_squared()).max(0.0)
     }
 
     /// Checks a batch of query points (q×M) before prediction.
@@ -119,25 +124,37 @@ impl GpMap {
         check_finite("query points", queries.as_slice())
     }
 
-    /// Means (p×M) and variances (M) at the columns of `queries` (q×M), rows in parallel.
+    /// Means (p×M) and variances (M) at the columns of `queries` (q×M), points in parallel.
     pub fn predict(&self, queries: &DMatrix<f64>) -> Result<(DMatrix<f64>, DVector<f64>)> {
         self.check_queries(queries)?;
-        let p = self.output_dim();
-        let m = queries.ncols();
-        let mut means = DMatrix::zeros(p, m);
-        let mut variances = DVector::zeros(m);
-        means
-            .as_mut_slice()
-            .par_chunks_mut(p)
-            .zip(variances.as_mut_slice().par_iter_mut())
-            .enumerate()
-            .for_each_init(
+        let mut means = DMatrix::zeros(self.output_dim(), queries.ncols());
+        let mut variances = DVector::zeros(queries.ncols());
+        self.for_each_query(queries, &mut means, Some(variances.as_mut_slice()));
+        Ok((means, variances))
+    }
+
+    /// Means only (p×M), several times cheaper than [`Self::predict`]: no `O(N²)` solve.
+    pub fn predict_mean(&self, queries: &DMatrix<f64>) -> Result<DMatrix<f64>> {
+        self.check_queries(queries)?;
+        let mut means = DMatrix::zeros(self.output_dim(), queries.ncols());
+        self.for_each_query(queries, &mut means, None);
+        Ok(means)
+    }
+
+    fn for_each_query(&self, queries: &DMatrix<f64>, means: &mut DMatrix<f64>, variances: Option<&mut [f64]>) {
+        let rows = means.as_mut_slice().par_chunks_mut(self.output_dim()).enumerate();
+        match variances {
+            Some(variances) => rows.zip(variances.par_iter_mut()).for_each_init(
                 || self.scratch(),
-                |scratch, (j, (mean_out, var_out))| {
+                |scratch, ((j, mean_out), var_out)| {
                     *var_out = self.predict_into(queries.column(j).as_slice(), mean_out, scratch);
                 },
-            );
-        Ok((means, variances))
+            ),
+            None => rows.for_each_init(
+                || self.scratch(),
+                |scratch, (j, mean_out)| self.mean_into(queries.column(j).as_slice(), mean_out, scratch),
+            ),
+        }
     }
 }
 
@@ -186,6 +203,7 @@ mod tests {
         let gp = toy();
         let q = DMatrix::from_fn(2, 5, |i, j| (i as f64 - j as f64) * 0.3);
         let (means, vars) = gp.predict(&q).unwrap();
+        assert_eq!(gp.predict_mean(&q).unwrap(), means);
         for j in 0..5 {
             let mut m = vec![0.0; 3];
             let v = gp.predict_into(q.column(j).as_slice(), &mut m, &mut gp.scratch());

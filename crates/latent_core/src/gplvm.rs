@@ -41,7 +41,7 @@ pub fn nll_grad(latent: &DMatrix<f64>, centred: &DMatrix<f64>, log_theta: [f64; 
     let dims = centred.nrows() as f64;
 
     let k = kernel.matrix(latent);
-    let factor = factorize(k)?;
+    let factor = factorize(k.clone())?;
     let chol = &factor.cholesky;
     let y = centred.transpose(); // N×D
     let a = chol.solve(&y); // K⁻¹ Y
@@ -49,29 +49,35 @@ pub fn nll_grad(latent: &DMatrix<f64>, centred: &DMatrix<f64>, log_theta: [f64; 
     let fit: f64 = y.component_mul(&a).sum();
     let nll = 0.5 * dims * log_det + 0.5 * fit + 0.5 * (n as f64) * dims * (2.0 * std::f64::consts::PI).ln();
 
-    // G = ∂L/∂K, symmetric.
-    let g = (chol.inverse() * dims - &a * a.transpose()) * 0.5;
+    // G = ∂L/∂K = ½(D K⁻¹ − A Aᵀ), symmetric.
+    let mut g = factor.inverse() * (0.5 * dims);
+    g.gemm(-0.5, &a, &a.transpose(), 1.0);
 
-    let mut grad_latent = DMatrix::zeros(latent.nrows(), n);
+    // Off the diagonal K_ij is the SE part; K_ij and K_ji both depend on z_i with
+    // ∂K_ij/∂z_i = −K_ij (z_i − z_j)/θ2.
+    let q = latent.nrows();
+    let mut grad_latent = DMatrix::zeros(q, n);
     let mut grad_log_theta = [0.0; 3];
-    for j in 0..n {
-        for i in 0..n {
+    for i in 0..n {
+        let zi = latent.column(i);
+        let mut grad_i = grad_latent.column_mut(i);
+        for j in 0..n {
             if i == j {
                 continue;
             }
-            let zi = latent.column(i);
             let zj = latent.column(j);
-            let r2 = (zi - zj).norm_squared();
-            let se = kernel.se(zi.as_slice(), zj.as_slice());
-            let gse = g[(i, j)] * se;
+            let gse = g[(i, j)] * k[(i, j)];
+            let mut r2 = 0.0;
+            let coeff = -2.0 * gse / kernel.lengthscale_sq;
+            for c in 0..q {
+                let diff = zi[c] - zj[c];
+                r2 += diff * diff;
+                grad_i[c] += coeff * diff;
+            }
             grad_log_theta[0] += gse;
             grad_log_theta[1] += gse * r2 / (2.0 * kernel.lengthscale_sq);
-            // K_ij and K_ji both depend on z_i: dK_ij/dz_i = −se (z_i − z_j)/θ2.
-            let coeff = -2.0 * gse / kernel.lengthscale_sq;
-            let mut col = grad_latent.column_mut(i);
-            col.axpy(coeff, &(zi - zj), 1.0);
         }
-        grad_log_theta[0] += g[(j, j)] * kernel.variance;
+        grad_log_theta[0] += g[(i, i)] * kernel.variance;
     }
     grad_log_theta[2] = kernel.noise * g.trace();
     Ok(NllGrad { nll, grad_latent, grad_log_theta, jitter: factor.jitter })
