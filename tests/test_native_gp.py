@@ -5,6 +5,7 @@ inverse of the reference is accurate to ~1e-12: the tolerances below (rtol 1e-9)
 """
 
 import ast
+import inspect
 from pathlib import Path
 
 import numpy as np
@@ -143,13 +144,16 @@ def test_stub_declares_the_native_module():
     assert isinstance(_native.__version__, str) and latentrl.__version__ == _native.__version__
 
     def stub_params(node):
-        return [a.arg for a in node.args.args if a.arg not in ("self", "cls")]
+        args = node.args
+        positional = [a.arg for a in args.posonlyargs + args.args if a.arg not in ("self", "cls")]
+        return positional + ["*" + a.arg for a in args.kwonlyargs]
 
     def runtime_params(obj):
+        kw_only = inspect.Parameter.KEYWORD_ONLY
         return [
-            p.strip()
-            for p in obj.__text_signature__.strip("()").split(",")
-            if p.strip() not in ("$self", "")
+            ("*" if p.kind is kw_only else "") + p.name
+            for p in inspect.signature(obj).parameters.values()
+            if p.name not in ("self", "cls")
         ]
 
     for name, node in declared.items():

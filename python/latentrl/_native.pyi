@@ -1,9 +1,10 @@
 """Stubs of the Rust extension `latentrl._native` (hand-written; checked by mypy.stubtest)."""
 
-from typing import final
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any, Literal, final
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "GpMap",
@@ -15,6 +16,7 @@ __all__ = [
     "arms_fk",
     "arms_ik",
     "gplvm_nll_grad",
+    "run_bimanual_trials",
 ]
 
 __version__: str
@@ -74,3 +76,22 @@ def arms_elbows(postures: NDArray[np.float64]) -> NDArray[np.float64]:
 def arms_ik(hands: NDArray[np.float64]) -> NDArray[np.float64]:
     """Postures `(N, 4)` (elbows outward, shoulder angles continuous in front of the body) that
     put the hands at `hands` `(N, 4)`; an unreachable row raises InvalidInputError."""
+
+def run_bimanual_trials(
+    learner: Literal["full", "latent"],
+    *,
+    n_trials: int,
+    episodes: int,
+    base_seed: int,
+    first_trial: int | None = None,
+    config: Mapping[str, object] | None = None,
+    decoder: GpMap | None = None,
+    encoder: GpMap | None = None,
+    latent_low: ArrayLike | None = None,
+    latent_high: ArrayLike | None = None,
+    record_episodes: Sequence[int] | None = None,
+    return_weights: bool = False,
+    progress: Callable[[int, int], object] | None = None,
+) -> dict[str, Any]:
+    """Runs Experiment 1 (SPEC §4.1) trials in parallel in Rust; see
+    `run_bimanual_trials.__doc__` for every argument and the returned arrays."""

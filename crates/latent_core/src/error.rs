@@ -50,6 +50,15 @@ pub enum CoreError {
         /// The largest jitter tried.
         jitter: f64,
     },
+    /// No admissible episode start was found.
+    #[error(
+        "no admissible start state in {draws} draws: every drawn start was refused by the plant \
+         (obstacle, drop, box) or by variance gating; check the start distribution and the box"
+    )]
+    NoValidStart {
+        /// How many starts were drawn.
+        draws: usize,
+    },
 }
 
 /// Result alias for the core.

@@ -3,12 +3,25 @@
 //! every step in latent space. Pure Rust: no Python needed to use or test it.
 #![warn(missing_docs)]
 
+pub mod episode;
 pub mod error;
 pub mod gp;
 pub mod gplvm;
 pub mod kernel;
+pub mod policy;
+pub mod rbf;
+pub mod td;
+pub mod trials;
 
+pub use episode::{
+    EndReason, EpisodeRecord, EpisodeScratch, Learner, LearnerConfig, Plant, StartMode, StateSpace, StepOutcome,
+    StepResult,
+};
 pub use error::{CoreError, Result};
 pub use gp::{GpMap, PredictScratch};
 pub use gplvm::{nll_grad, NllGrad};
 pub use kernel::{factorize, Factor, SeKernel};
+pub use policy::{orthogonal_actions, SoftmaxPolicy};
+pub use rbf::{RbfConfig, RbfGrid, SparseFeatures};
+pub use td::{TdConfig, TdLearner};
+pub use trials::{run_trials, trial_rng, TrialOptions, TrialResult};

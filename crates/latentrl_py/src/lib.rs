@@ -4,6 +4,8 @@
 mod convert;
 mod errors;
 mod gp;
+mod rl;
+mod sim;
 
 use pyo3::prelude::*;
 
@@ -12,6 +14,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     m.add_class::<gp::PyGpMap>()?;
     m.add_function(wrap_pyfunction!(gp::gplvm_nll_grad, m)?)?;
+    m.add_function(wrap_pyfunction!(sim::arms_fk, m)?)?;
+    m.add_function(wrap_pyfunction!(sim::arms_elbows, m)?)?;
+    m.add_function(wrap_pyfunction!(sim::arms_ik, m)?)?;
+    m.add_function(wrap_pyfunction!(rl::run_bimanual_trials, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

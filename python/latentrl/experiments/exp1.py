@@ -7,7 +7,26 @@ A full-space learner (4-D hand positions, 12 actions, 20⁴ RBFs) against a late
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from latentrl import _native
+from latentrl.datasets import bimanual_pairs
+from latentrl.experiments.presets import latent_box
+from latentrl.experiments.runner import Setup, run_rl
+from latentrl.gplvm import GPLVM
+from latentrl.plots import hand_paths, learning_curves, save_figure
+
+TARGET = np.array([0.0, 0.0, 0.1, 0.0])
+"""x* of the reward (paper): left hand at the origin, right hand 0.1 to its right."""
+OBSTACLE_CENTRE = (0.5, 0.5)
+"""Centre of the obstacle disc (ours: the paper only draws it)."""
 
 
 @dataclass(frozen=True)
@@ -59,3 +78,88 @@ class Exp1Preset:
     def quick(cls) -> Exp1Preset:
         """The CI smoke test: step 0.5 × spacing, 500 episodes × 500 steps, 3 trials."""
         return dataclasses.replace(cls(), trials=3, episodes=500, step_fraction=0.5)
+
+
+def recorded_episodes(episodes: int) -> list[int]:
+    """Episodes whose hand paths are kept: three during learning (Fig. 4b), the last three (4c)."""
+    during = [0, episodes // 10, episodes // 2]
+    after = list(range(max(episodes - 3, 0), episodes))
+    return sorted(set(during + after))
+
+
+def native_config(preset: Exp1Preset) -> dict[str, Any]:
+    """The preset in the native call's configuration keys."""
+    return {
+        "drop_tolerance": preset.drop_tolerance,
+        "theta": preset.reward_theta,
+        "obstacle_centre": list(OBSTACLE_CENTRE),
+        "obstacle_radius": preset.obstacle_radius,
+        "target": TARGET.tolist(),
+        "start_sd": preset.start_std,
+        "reached_rms": preset.reach_radius,
+        "alpha": preset.alpha,
+        "gamma": preset.gamma,
+        "initial_weight": preset.initial_weight,
+        "beta": preset.beta,
+        "step_fraction": preset.step_fraction,
+        "max_steps": preset.steps,
+        "centres_per_dim": preset.rbf_per_dim,
+        "rbf_cutoff": preset.rbf_cutoff,
+        "variance_threshold": preset.variance_threshold or None,
+    }
+
+
+def setup(preset: Exp1Preset) -> Setup:
+    """Demonstrations, the GPLVM and its latent box, and both learners' trial runners."""
+    demos = bimanual_pairs(preset.n_demos, np.random.default_rng(preset.seed))
+    model = GPLVM(n_components=2, max_iter=preset.gplvm_max_iter, random_state=preset.seed).fit(demos)
+    low, high = latent_box(model.Z_, preset.latent_margin)
+    run = partial(
+        _native.run_bimanual_trials,
+        episodes=preset.episodes,
+        base_seed=preset.seed,
+        config=native_config(preset),
+        record_episodes=recorded_episodes(preset.episodes),
+    )
+    learners = {
+        "latent": partial(
+            run, "latent", decoder=model.decoder_, encoder=model.encoder_, latent_low=low, latent_high=high
+        ),
+        "full": partial(run, "full"),
+    }
+    info = {
+        "gplvm": {
+            "nll": model.nll_,
+            "theta": model.theta_,
+            "converged": model.converged_,
+            "n_iter": model.n_iter_,
+            "encoder_theta": model.encoder_theta_,
+        },
+        "latent_box": {"low": low, "high": high},
+        "recorded_episodes": recorded_episodes(preset.episodes),
+    }
+    return Setup(learners=learners, info=info)
+
+
+def figures(preset: Exp1Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
+    """Fig. 4a (learning curves), 4b (hand paths during learning), 4c (after learning)."""
+    fig, ax = plt.subplots(figsize=(6, 4))
+    learning_curves(ax, {name: arrays[name] for name in ("latent", "full") if name in arrays})
+    ax.set_title("Exp 1: bimanual reaching, mean ± s.d. over trials")
+    save_figure(fig, out, "fig4a")
+    record = recorded_episodes(preset.episodes)
+    disc = ((*OBSTACLE_CENTRE, preset.obstacle_radius),)
+    for name, episodes in (("fig4b", record[:3]), ("fig4c", record[-3:])):
+        fig, axes = plt.subplots(1, 2, figsize=(9, 4.5), sharex=True, sharey=True)
+        for ax, learner in zip(axes, ("latent", "full")):
+            paths = arrays.get(f"{learner}_paths")
+            if paths is None:
+                continue
+            hand_paths(ax, paths[0, [record.index(e) for e in episodes]], target=TARGET, discs=disc)
+            ax.set_title(f"{learner}: episodes {', '.join(str(e + 1) for e in episodes)} (trial 1)")
+        save_figure(fig, out, name)
+
+
+def run_exp1(preset: Exp1Preset, out_dir: Path | str, *, progress: bool = True) -> dict[str, Any]:
+    """Runs (or continues) Experiment 1 into `out_dir` (results.json, returns.npz, fig4*)."""
+    return run_rl(preset, out_dir, setup=setup, figures=figures, progress=progress)

@@ -9,6 +9,8 @@ import textwrap
 from functools import cache
 from typing import Any
 
+import numpy as np
+
 
 @cache
 def field_docs(preset_cls: type) -> dict[str, str]:
@@ -31,3 +33,10 @@ def field_docs(preset_cls: type) -> dict[str, str]:
 def describe(preset: Any) -> dict[str, Any]:
     """Every field of a preset with its value, for the results metadata."""
     return {"name": type(preset).__name__, **dataclasses.asdict(preset)}
+
+
+def latent_box(latent: np.ndarray, margin: float) -> tuple[np.ndarray, np.ndarray]:
+    """The bounding box of the latent points, widened by `margin` of its width per side."""
+    low, high = latent.min(axis=0), latent.max(axis=0)
+    pad = margin * (high - low)
+    return low - pad, high + pad

@@ -1,0 +1,154 @@
+//! TD(0) V-learning with a linear value function (paper Sec. III-D, Eq. 7–9).
+//!
+//! `V(s) = wᵀ b(s)` (Eq. 7), TD error `δ_t = r_t + γ V(s_{t+1}) − V(s_t)` (Eq. 8) and the
+//! update `w ← w + α δ_t b(s_t)` (Eq. 9). A terminal transition (an episode ended by a
+//! penalty) uses `V(s_{t+1}) = 0`.
+
+use crate::error::{check_finite, check_positive, CoreError, Result};
+use crate::rbf::SparseFeatures;
+
+/// Learning parameters; `Default` is the paper's Experiment 1 (α = 0.9, γ = 0.95, w₀ = 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TdConfig {
+    /// Learning rate α of Eq. 9 (paper: 0.9 for Exp. 1, 0.8 for Exp. 2); must be > 0.
+    pub alpha: f64,
+    /// Discount factor γ of Eq. 8 (paper: 0.95 for Exp. 1, 0.99 for Exp. 2); in [0, 1].
+    pub gamma: f64,
+    /// Every weight's initial value w₀ (paper-like: 0; optimistic knob: e.g. 1/(1 − γ)).
+    pub initial_weight: f64,
+}
+
+impl Default for TdConfig {
+    fn default() -> Self {
+        Self { alpha: 0.9, gamma: 0.95, initial_weight: 0.0 }
+    }
+}
+
+impl TdConfig {
+    /// Checks α > 0, 0 ≤ γ ≤ 1 and a finite w₀.
+    pub fn validate(&self) -> Result<()> {
+        check_positive("alpha (learning rate)", self.alpha)?;
+        if !(0.0..=1.0).contains(&self.gamma) {
+            return Err(CoreError::InvalidParameter {
+                name: "gamma (discount)",
+                value: self.gamma,
+                reason: "must lie in [0, 1]",
+            });
+        }
+        check_finite("initial_weight", &[self.initial_weight])
+    }
+}
+
+/// The weights `w` of `V(s) = wᵀ b(s)` and the TD(0) update (Eq. 7–9).
+#[derive(Debug, Clone)]
+pub struct TdLearner {
+    weights: Vec<f64>,
+    alpha: f64,
+    gamma: f64,
+}
+
+impl TdLearner {
+    /// `n_features` weights set to `config.initial_weight`.
+    pub fn new(n_features: usize, config: &TdConfig) -> Result<Self> {
+        config.validate()?;
+        if n_features == 0 {
+            return Err(CoreError::Empty { what: "value-function features" });
+        }
+        Ok(Self { weights: vec![config.initial_weight; n_features], alpha: config.alpha, gamma: config.gamma })
+    }
+
+    /// The weights `w`, one per feature.
+    pub fn weights(&self) -> &[f64] {
+        &self.weights
+    }
+
+    /// Consumes the learner, returning `w`.
+    pub fn into_weights(self) -> Vec<f64> {
+        self.weights
+    }
+
+    /// Discount factor γ.
+    pub fn gamma(&self) -> f64 {
+        self.gamma
+    }
+
+    /// Learning rate α.
+    pub fn alpha(&self) -> f64 {
+        self.alpha
+    }
+
+    /// `V(s) = wᵀ b(s)` (Eq. 7).
+    #[inline]
+    pub fn value(&self, features: &SparseFeatures) -> f64 {
+        features.dot(&self.weights)
+    }
+
+    /// One TD(0) update from `b(s_t)`, reward `r_t` and `V(s_{t+1})` — `None` for a terminal
+    /// transition, i.e. `V(s_{t+1}) = 0`. Returns `δ_t = r_t + γ V(s_{t+1}) − V(s_t)`
+    /// (Eq. 8) after applying `w ← w + α δ_t b(s_t)` (Eq. 9).
+    #[inline]
+    pub fn update(&mut self, features: &SparseFeatures, reward: f64, next_value: Option<f64>) -> f64 {
+        let delta = reward + self.gamma * next_value.unwrap_or(0.0) - self.value(features);
+        let step = self.alpha * delta;
+        for (&i, &b) in features.indices.iter().zip(&features.values) {
+            self.weights[i] += step * b;
+        }
+        delta
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn features(pairs: &[(usize, f64)]) -> SparseFeatures {
+        SparseFeatures { indices: pairs.iter().map(|p| p.0).collect(), values: pairs.iter().map(|p| p.1).collect() }
+    }
+
+    #[test]
+    fn update_follows_eq_8_and_9() {
+        let cfg = TdConfig { alpha: 0.5, gamma: 0.9, initial_weight: 1.0 };
+        let mut td = TdLearner::new(4, &cfg).unwrap();
+        let b = features(&[(1, 0.25), (2, 0.75)]);
+        assert_eq!(td.value(&b), 1.0);
+        // δ = 0.3 + 0.9·2 − 1 = 1.1; w_i += 0.5·1.1·b_i.
+        let delta = td.update(&b, 0.3, Some(2.0));
+        assert!((delta - 1.1).abs() < 1e-15);
+        assert_eq!(td.weights()[0], 1.0);
+        assert!((td.weights()[1] - (1.0 + 0.55 * 0.25)).abs() < 1e-15);
+        assert!((td.weights()[2] - (1.0 + 0.55 * 0.75)).abs() < 1e-15);
+        assert_eq!(td.weights()[3], 1.0);
+    }
+
+    #[test]
+    fn terminal_uses_zero_next_value() {
+        let mut td = TdLearner::new(2, &TdConfig { initial_weight: 0.5, ..TdConfig::default() }).unwrap();
+        let b = features(&[(0, 1.0)]);
+        let delta = td.update(&b, -1.0, None);
+        assert!((delta - (-1.5)).abs() < 1e-15);
+        assert!((td.weights()[0] - (0.5 - 0.9 * 1.5)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn converges_to_the_fixed_point_of_a_chain() {
+        // Two states, one-hot features: s0 → s1 (r = 0), s1 → terminal (r = 1).
+        // Fixed point: V(s1) = 1, V(s0) = γ.
+        let mut td = TdLearner::new(2, &TdConfig { alpha: 0.3, gamma: 0.9, initial_weight: 0.0 }).unwrap();
+        let (b0, b1) = (features(&[(0, 1.0)]), features(&[(1, 1.0)]));
+        for _ in 0..200 {
+            let v1 = td.value(&b1);
+            td.update(&b0, 0.0, Some(v1));
+            td.update(&b1, 1.0, None);
+        }
+        assert!((td.weights()[1] - 1.0).abs() < 1e-9);
+        assert!((td.weights()[0] - 0.9).abs() < 1e-9);
+    }
+
+    #[test]
+    fn rejects_bad_parameters() {
+        assert!(TdLearner::new(3, &TdConfig { alpha: 0.0, ..Default::default() }).is_err());
+        assert!(TdLearner::new(3, &TdConfig { gamma: 1.5, ..Default::default() }).is_err());
+        assert!(TdLearner::new(3, &TdConfig { initial_weight: f64::INFINITY, ..Default::default() }).is_err());
+        assert!(TdLearner::new(0, &TdConfig::default()).is_err());
+    }
+}

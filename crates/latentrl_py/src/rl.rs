@@ -1,0 +1,473 @@
+//! Binding of `latent_core::{episode, trials}` and `sim::bimanual`: Experiment 1 trials in
+//! one call. Arguments are checked here; every decision is the core's.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
+
+use ::sim::bimanual::{run_bimanual_trials as run_core, BimanualConfig, BimanualLearner};
+use latent_core::{GpMap, LearnerConfig, StartMode, TrialOptions, TrialResult};
+use numpy::{PyArray1, PyArrayMethods};
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::errors::{to_py, InvalidInputError};
+use crate::gp::PyGpMap;
+
+/// How often the calling thread wakes to check Ctrl-C and report progress.
+const POLL: Duration = Duration::from_millis(100);
+
+fn invalid(msg: String) -> PyErr {
+    InvalidInputError::new_err(msg)
+}
+
+/// A Python int in `[min, max]`.
+fn int_in(name: &str, value: &Bound<'_, PyAny>, min: i128, max: i128) -> PyResult<i128> {
+    let v: i128 = value.extract().map_err(|_| invalid(format!("{name}: expected an int, got {}", type_name(value))))?;
+    if v < min || v > max {
+        return Err(invalid(format!("{name} must lie in [{min}, {max}], got {v}")));
+    }
+    Ok(v)
+}
+
+fn type_name(value: &Bound<'_, PyAny>) -> String {
+    value.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "?".into())
+}
+
+fn float(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
+    let v: f64 = value
+        .extract()
+        .map_err(|_| invalid(format!("config[{name:?}]: expected a number, got {}", type_name(value))))?;
+    if !v.is_finite() {
+        return Err(invalid(format!("config[{name:?}] must be finite, got {v}")));
+    }
+    Ok(v)
+}
+
+fn floats<const N: usize>(name: &str, value: &Bound<'_, PyAny>) -> PyResult<[f64; N]> {
+    let v: Vec<f64> = value.extract().map_err(|_| {
+        invalid(format!("config[{name:?}]: expected a sequence of {N} numbers, got {}", type_name(value)))
+    })?;
+    let arr: [f64; N] = v
+        .try_into()
+        .map_err(|v: Vec<f64>| invalid(format!("config[{name:?}]: expected {N} numbers, got {}", v.len())))?;
+    if let Some(x) = arr.iter().find(|x| !x.is_finite()) {
+        return Err(invalid(format!("config[{name:?}] must be finite, got {x}")));
+    }
+    Ok(arr)
+}
+
+/// The configuration keys, in the order they are documented and echoed.
+const KEYS: [&str; 24] = [
+    "drop_tolerance",
+    "grip",
+    "obstacle_centre",
+    "obstacle_radius",
+    "box_low",
+    "box_high",
+    "target",
+    "theta",
+    "start_mean",
+    "start_sd",
+    "penalty",
+    "reached_rms",
+    "alpha",
+    "gamma",
+    "initial_weight",
+    "beta",
+    "step_fraction",
+    "max_steps",
+    "centres_per_dim",
+    "rbf_width",
+    "rbf_cutoff",
+    "variance_threshold",
+    "start",
+    "max_start_draws",
+];
+
+/// Applies `config` (a dict of overrides) to the defaults.
+fn apply_config(config: Option<&Bound<'_, PyDict>>) -> PyResult<(BimanualConfig, LearnerConfig)> {
+    let mut plant = BimanualConfig::default();
+    let mut learner = LearnerConfig::default();
+    let Some(config) = config else {
+        return Ok((plant, learner));
+    };
+    for (key, value) in config.iter() {
+        let key: String =
+            key.extract().map_err(|_| invalid(format!("config: keys must be strings, got {}", type_name(&key))))?;
+        let v = &value;
+        match key.as_str() {
+            "drop_tolerance" => plant.drop_tolerance = float(&key, v)?,
+            "grip" => plant.grip = floats(&key, v)?,
+            "obstacle_centre" => plant.obstacle_centre = floats(&key, v)?,
+            "obstacle_radius" => plant.obstacle_radius = float(&key, v)?,
+            "box_low" => plant.box_low = float(&key, v)?,
+            "box_high" => plant.box_high = float(&key, v)?,
+            "target" => plant.target = floats(&key, v)?,
+            "theta" => plant.theta = float(&key, v)?,
+            "start_mean" => plant.start_mean = floats(&key, v)?,
+            "start_sd" => plant.start_sd = float(&key, v)?,
+            "penalty" => {
+                plant.penalty = float(&key, v)?;
+                learner.penalty = plant.penalty;
+            }
+            "reached_rms" => plant.reached_rms = float(&key, v)?,
+            "alpha" => learner.td.alpha = float(&key, v)?,
+            "gamma" => learner.td.gamma = float(&key, v)?,
+            "initial_weight" => learner.td.initial_weight = float(&key, v)?,
+            "beta" => learner.beta = float(&key, v)?,
+            "step_fraction" => learner.step_fraction = float(&key, v)?,
+            "max_steps" => learner.max_steps = int_in("config[\"max_steps\"]", v, 1, 100_000_000)? as usize,
+            "centres_per_dim" => {
+                learner.rbf.centres_per_dim = int_in("config[\"centres_per_dim\"]", v, 2, 100_000)? as usize
+            }
+            "rbf_width" => learner.rbf.width = float(&key, v)?,
+            "rbf_cutoff" => learner.rbf.cutoff = float(&key, v)?,
+            "variance_threshold" => learner.variance_threshold = if v.is_none() { None } else { Some(float(&key, v)?) },
+            "start" => {
+                let s: String =
+                    v.extract().map_err(|_| invalid("config[\"start\"]: expected \"plant\" or \"uniform\"".into()))?;
+                learner.start = match s.as_str() {
+                    "plant" => StartMode::FromPlant,
+                    "uniform" => StartMode::UniformInBox,
+                    other => {
+                        return Err(invalid(format!(
+                            "config[\"start\"]: expected \"plant\" or \"uniform\", got {other:?}"
+                        )))
+                    }
+                }
+            }
+            "max_start_draws" => {
+                learner.max_start_draws = int_in("config[\"max_start_draws\"]", v, 1, 1_000_000_000)? as usize
+            }
+            other => {
+                return Err(invalid(format!("config: unknown key {other:?}; valid keys: {}", KEYS.join(", "))));
+            }
+        }
+    }
+    plant.validate().map_err(to_py)?;
+    learner.validate().map_err(to_py)?;
+    Ok((plant, learner))
+}
+
+/// The effective configuration as a dict (every key of `KEYS`).
+fn echo_config<'py>(py: Python<'py>, plant: &BimanualConfig, learner: &LearnerConfig) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("drop_tolerance", plant.drop_tolerance)?;
+    d.set_item("grip", plant.grip.to_vec())?;
+    d.set_item("obstacle_centre", plant.obstacle_centre.to_vec())?;
+    d.set_item("obstacle_radius", plant.obstacle_radius)?;
+    d.set_item("box_low", plant.box_low)?;
+    d.set_item("box_high", plant.box_high)?;
+    d.set_item("target", plant.target.to_vec())?;
+    d.set_item("theta", plant.theta)?;
+    d.set_item("start_mean", plant.start_mean.to_vec())?;
+    d.set_item("start_sd", plant.start_sd)?;
+    d.set_item("penalty", plant.penalty)?;
+    d.set_item("reached_rms", plant.reached_rms)?;
+    d.set_item("alpha", learner.td.alpha)?;
+    d.set_item("gamma", learner.td.gamma)?;
+    d.set_item("initial_weight", learner.td.initial_weight)?;
+    d.set_item("beta", learner.beta)?;
+    d.set_item("step_fraction", learner.step_fraction)?;
+    d.set_item("max_steps", learner.max_steps)?;
+    d.set_item("centres_per_dim", learner.rbf.centres_per_dim)?;
+    d.set_item("rbf_width", learner.rbf.width)?;
+    d.set_item("rbf_cutoff", learner.rbf.cutoff)?;
+    d.set_item("variance_threshold", learner.variance_threshold)?;
+    d.set_item("start", if learner.start == StartMode::FromPlant { "plant" } else { "uniform" })?;
+    d.set_item("max_start_draws", learner.max_start_draws)?;
+    Ok(d)
+}
+
+fn gp_map<'a, 'py>(name: &str, value: &'a Option<Bound<'py, PyAny>>) -> PyResult<Option<&'a Bound<'py, PyGpMap>>> {
+    match value {
+        None => Ok(None),
+        Some(v) if v.is_none() => Ok(None),
+        Some(v) => v
+            .cast::<PyGpMap>()
+            .map(Some)
+            .map_err(|_| invalid(format!("{name}: expected a GpMap, got {}", type_name(v)))),
+    }
+}
+
+fn corner(name: &'static str, value: Option<&Bound<'_, PyAny>>, dim: usize) -> PyResult<Vec<f64>> {
+    let value =
+        value.filter(|v| !v.is_none()).ok_or_else(|| invalid(format!("{name} is required for learner=\"latent\"")))?;
+    let v: Vec<f64> = value
+        .extract()
+        .map_err(|_| invalid(format!("{name}: expected a 1-D array of {dim} numbers, got {}", type_name(value))))?;
+    if v.len() != dim {
+        return Err(invalid(format!(
+            "{name}: expected shape ({dim},) (the decoder's input dimension), got ({},)",
+            v.len()
+        )));
+    }
+    latent_core::error::check_finite(name, &v).map_err(to_py)?;
+    Ok(v)
+}
+
+/// Runs Experiment 1 (SPEC §4.1) trials in parallel in Rust and returns their records.
+///
+/// learner: "full" (12 actions, 20⁴ RBFs over the hands' box) or "latent" (2·d orthogonal
+///     actions, 20^d RBFs over [latent_low, latent_high]; needs decoder, encoder and both
+///     corners).
+/// n_trials, episodes: T trials of E episodes each.
+/// base_seed: trial i draws from ChaCha8(base_seed, stream i): same seed ⇒ same arrays,
+///     whatever the thread count.
+/// first_trial: run trials first_trial .. first_trial + n_trials (to resume a sweep);
+///     None means 0.
+/// config: overrides of the defaults (SPEC §4.1) — plant: drop_tolerance (0.1), grip
+///     ([0.1, 0]), obstacle_centre ([0.5, 0.5]), obstacle_radius (0.2), box_low (-0.5),
+///     box_high (1.5), target ([0, 0, 0.1, 0]), theta (0.75), start_mean ([1, 1]),
+///     start_sd (0.1), penalty (-1, also the learner's box/gate penalty), reached_rms (0.1);
+///     learner: alpha (0.9), gamma (0.95), initial_weight (0), beta (10), step_fraction
+///     (0.2), max_steps (500), centres_per_dim (20), rbf_width (1, σ/spacing), rbf_cutoff
+///     (3, in σ), variance_threshold (None), start ("plant" | "uniform"), max_start_draws
+///     (1000). Unknown keys raise InvalidInputError.
+/// decoder, encoder: GpMap latent (d) → posture (4) and posture (4) → latent (d).
+/// latent_low, latent_high: (d,) corners of the latent box.
+/// record_episodes: episode indices whose hand trajectories are recorded in every trial.
+/// return_weights: also return each trial's final value-function weights.
+/// progress: called as progress(episodes_done, episodes_total) about every 0.1 s and at
+///     the end; an exception in it stops the run and propagates.
+///
+/// Returns a dict: "returns" (T, E) float64 (NaN where not run), "ends" (T, E) int8
+/// (0 time-out, 1 obstacle, 2 box exit, 3 drop, 4 fall, 5 variance gate; -1 not run),
+/// "steps" (T, E) int64, "reached" (T, E) bool (RMS hand distance to the target
+/// ≤ reached_rms at some step), "finished" (T,) bool, "trials" (T,) int64 trial indices,
+/// "trajectories" (T, R, max_steps + 1, 4) float64 hands (x_L, y_L, x_R, y_R) after the
+/// reset and after each plant step, NaN-padded, "weights" (T, M) float64 or None,
+/// "learner_low" / "learner_high" / "spacing" (d,) of the RBF grid, "n_actions",
+/// "n_centres", and "config" (every key above, effective values).
+/// Ctrl-C stops all trials and raises KeyboardInterrupt.
+#[pyfunction]
+#[pyo3(signature = (
+    learner, *, n_trials, episodes, base_seed, first_trial = None, config = None, decoder = None,
+    encoder = None, latent_low = None, latent_high = None, record_episodes = None,
+    return_weights = false, progress = None,
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_bimanual_trials<'py>(
+    py: Python<'py>,
+    learner: &Bound<'py, PyAny>,
+    n_trials: &Bound<'py, PyAny>,
+    episodes: &Bound<'py, PyAny>,
+    base_seed: &Bound<'py, PyAny>,
+    first_trial: Option<&Bound<'py, PyAny>>,
+    config: Option<&Bound<'py, PyAny>>,
+    decoder: Option<Bound<'py, PyAny>>,
+    encoder: Option<Bound<'py, PyAny>>,
+    latent_low: Option<&Bound<'py, PyAny>>,
+    latent_high: Option<&Bound<'py, PyAny>>,
+    record_episodes: Option<&Bound<'py, PyAny>>,
+    return_weights: bool,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let name: String = learner
+        .extract()
+        .map_err(|_| invalid(format!("learner: expected \"full\" or \"latent\", got {}", type_name(learner))))?;
+    let n_trials = int_in("n_trials", n_trials, 1, 1_000_000)? as usize;
+    let episodes = int_in("episodes", episodes, 1, 100_000_000)? as usize;
+    let base_seed = int_in("base_seed", base_seed, 0, u64::MAX as i128)? as u64;
+    let first_trial = match first_trial.filter(|v| !v.is_none()) {
+        Some(v) => int_in("first_trial", v, 0, 1 << 40)? as usize,
+        None => 0,
+    };
+    let config = match config {
+        Some(c) if c.is_none() => None,
+        Some(c) => {
+            Some(c.cast::<PyDict>().map_err(|_| invalid(format!("config: expected a dict, got {}", type_name(c))))?)
+        }
+        None => None,
+    };
+    let (plant, learner_config) = apply_config(config)?;
+    let record: Vec<usize> = match record_episodes {
+        Some(r) if !r.is_none() => {
+            let list: Vec<Bound<'py, PyAny>> = r
+                .try_iter()
+                .map_err(|_| invalid(format!("record_episodes: expected a sequence of ints, got {}", type_name(r))))?
+                .collect::<PyResult<_>>()?;
+            list.iter()
+                .map(|e| int_in("record_episodes[i]", e, 0, episodes as i128 - 1).map(|v| v as usize))
+                .collect::<PyResult<_>>()?
+        }
+        _ => Vec::new(),
+    };
+    if let Some(p) = &progress
+        && !p.is_none()
+        && !p.is_callable()
+    {
+        return Err(invalid(format!("progress: expected a callable or None, got {}", type_name(p))));
+    }
+    let progress = progress.filter(|p| !p.is_none());
+    let decoder = gp_map("decoder", &decoder)?;
+    let encoder = gp_map("encoder", &encoder)?;
+    let (low, high);
+    let bimanual = match name.as_str() {
+        "full" => {
+            let given = |v: Option<&Bound<'py, PyAny>>| v.is_some_and(|v| !v.is_none());
+            if decoder.is_some() || encoder.is_some() || given(latent_low) || given(latent_high) {
+                return Err(invalid(
+                    "learner=\"full\" takes no decoder, encoder, latent_low or latent_high (they are for learner=\"latent\")".into(),
+                ));
+            }
+            BimanualLearner::Full
+        }
+        "latent" => {
+            let decoder: &GpMap = &decoder
+                .ok_or_else(|| invalid("decoder (a GpMap latent → posture) is required for learner=\"latent\"".into()))?
+                .get()
+                .inner;
+            let encoder: &GpMap = &encoder
+                .ok_or_else(|| invalid("encoder (a GpMap posture → latent) is required for learner=\"latent\"".into()))?
+                .get()
+                .inner;
+            let dim = decoder.input_dim();
+            low = corner("latent_low", latent_low, dim)?;
+            high = corner("latent_high", latent_high, dim)?;
+            if let Some(k) = (0..dim).find(|&k| high[k] <= low[k]) {
+                return Err(invalid(format!(
+                    "latent_high[{k}] = {} must exceed latent_low[{k}] = {}",
+                    high[k], low[k]
+                )));
+            }
+            BimanualLearner::Latent { decoder, encoder, low: &low, high: &high }
+        }
+        other => return Err(invalid(format!("learner: expected \"full\" or \"latent\", got {other:?}"))),
+    };
+    // Validates the learner (grid size, dimensions) before any thread starts.
+    let (template, _) = bimanual.build(&plant, &learner_config).map_err(to_py)?;
+    let options = TrialOptions {
+        n_trials,
+        first_trial,
+        episodes,
+        base_seed,
+        record_episodes: record.clone(),
+        keep_weights: return_weights,
+    };
+    options.validate().map_err(to_py)?;
+
+    let results = run_with_polling(py, &plant, &learner_config, &bimanual, &options, progress.as_ref())?;
+
+    let out = PyDict::new(py);
+    pack_results(py, &out, &results, episodes, record.len(), learner_config.max_steps)?;
+    if return_weights {
+        let m = template.grid().len();
+        let mut w = Vec::with_capacity(n_trials * m);
+        for r in &results {
+            w.extend_from_slice(r.weights.as_deref().unwrap_or(&[]));
+        }
+        out.set_item("weights", PyArray1::from_vec(py, w).reshape([n_trials, m])?)?;
+    } else {
+        out.set_item("weights", py.None())?;
+    }
+    out.set_item("learner_low", PyArray1::from_vec(py, template.grid().low().to_vec()))?;
+    out.set_item("learner_high", PyArray1::from_vec(py, template.grid().high().to_vec()))?;
+    out.set_item("spacing", PyArray1::from_vec(py, template.grid().spacing().to_vec()))?;
+    out.set_item("n_actions", template.n_actions())?;
+    out.set_item("n_centres", template.grid().len())?;
+    out.set_item("config", echo_config(py, &plant, &learner_config)?)?;
+    Ok(out)
+}
+
+/// Runs the trials on a worker thread; this thread wakes every [`POLL`], re-attaches,
+/// checks for Ctrl-C and reports progress.
+fn run_with_polling(
+    py: Python<'_>,
+    plant: &BimanualConfig,
+    config: &LearnerConfig,
+    learner: &BimanualLearner<'_>,
+    options: &TrialOptions,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Vec<TrialResult>> {
+    let cancel = AtomicBool::new(false);
+    let done = AtomicUsize::new(0);
+    let worker_done = AtomicBool::new(false);
+    let total = options.n_trials * options.episodes;
+    std::thread::scope(|scope| {
+        let worker = scope.spawn(|| {
+            let r = run_core(plant, config, learner, options, &cancel, &done);
+            worker_done.store(true, Ordering::Release);
+            r
+        });
+        let stop = |err: PyErr| {
+            cancel.store(true, Ordering::Relaxed);
+            err
+        };
+        let mut failure = None;
+        loop {
+            let finished = py.detach(|| {
+                let deadline = Instant::now() + POLL;
+                while !worker_done.load(Ordering::Acquire) && Instant::now() < deadline {
+                    std::thread::sleep(Duration::from_millis(2));
+                }
+                worker_done.load(Ordering::Acquire)
+            });
+            if finished {
+                break;
+            }
+            if let Err(e) = py.check_signals() {
+                failure = Some(stop(e));
+                break;
+            }
+            if let Some(cb) = progress
+                && let Err(e) = cb.call1((done.load(Ordering::Relaxed), total))
+            {
+                failure = Some(stop(e));
+                break;
+            }
+        }
+        // On failure the cancel flag is set: the trials stop after their current episode.
+        let joined = py.detach(|| worker.join());
+        if let Some(e) = failure {
+            return Err(e);
+        }
+        let results =
+            joined.map_err(|_| PyRuntimeError::new_err("internal error: the trial worker panicked"))?.map_err(to_py)?;
+        if let Some(cb) = progress {
+            cb.call1((done.load(Ordering::Relaxed), total))?;
+        }
+        Ok(results)
+    })
+}
+
+/// Fills `out` with the per-episode arrays and the padded trajectories.
+fn pack_results<'py>(
+    py: Python<'py>,
+    out: &Bound<'py, PyDict>,
+    results: &[TrialResult],
+    episodes: usize,
+    n_record: usize,
+    max_steps: usize,
+) -> PyResult<()> {
+    let t = results.len();
+    let mut returns = vec![f64::NAN; t * episodes];
+    let mut ends = vec![-1i8; t * episodes];
+    let mut steps = vec![0i64; t * episodes];
+    let mut reached = vec![false; t * episodes];
+    let rows = max_steps + 1;
+    let mut traj = vec![f64::NAN; t * n_record * rows * 4];
+    for (i, r) in results.iter().enumerate() {
+        for (e, rec) in r.episodes.iter().enumerate() {
+            let k = i * episodes + e;
+            returns[k] = rec.ret;
+            ends[k] = rec.end.code() as i8;
+            steps[k] = rec.steps as i64;
+            reached[k] = rec.reached;
+        }
+        for (j, path) in r.trajectories.iter().enumerate() {
+            let start = (i * n_record + j) * rows * 4;
+            let n = path.len().min(rows * 4);
+            traj[start..start + n].copy_from_slice(&path[..n]);
+        }
+    }
+    out.set_item("returns", PyArray1::from_vec(py, returns).reshape([t, episodes])?)?;
+    out.set_item("ends", PyArray1::from_vec(py, ends).reshape([t, episodes])?)?;
+    out.set_item("steps", PyArray1::from_vec(py, steps).reshape([t, episodes])?)?;
+    out.set_item("reached", PyArray1::from_vec(py, reached).reshape([t, episodes])?)?;
+    out.set_item("finished", PyArray1::from_vec(py, results.iter().map(|r| r.finished).collect::<Vec<bool>>()))?;
+    out.set_item("trials", PyArray1::from_vec(py, results.iter().map(|r| r.trial as i64).collect::<Vec<i64>>()))?;
+    out.set_item("trajectories", PyArray1::from_vec(py, traj).reshape([t, n_record, rows, 4])?)?;
+    Ok(())
+}

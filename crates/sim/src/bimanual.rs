@@ -1,0 +1,362 @@
+//! Experiment 1 (SPEC §4.1, paper Sec. IV-A, Fig. 4): two planar hands carrying an object
+//! in end-effector space, as a kinematic [`Plant`], and the runner for its two learners.
+//!
+//! State (= posture) `x = (x_L, y_L, x_R, y_R)`; linear dynamics `x_{t+1} = x_t + δt·u`, so
+//! a step reaches its target exactly. The object is held while `‖(x_R − x_L) − g‖ ≤ tol`
+//! (`g = (0.1, 0)`); the hands must stay out of a disc obstacle and inside a box. The reward
+//! is `exp(−θ ‖x − x*‖²)` (Eq. 12); a step that ends the episode (obstacle, box exit, drop)
+//! earns that reward **plus** the penalty −1 (SPEC §3: "a penalty is added"; with this
+//! reading a full-space learner that drops after ≈ 1.5 steps returns ≈ −0.92, the figure
+//! SPEC §4.1 quotes).
+//!
+//! Learners: the full-space one ([`BimanualLearner::Full`]) has 12 actions
+//! ([`full_space_actions`]) and a 20⁴ RBF grid over the plant's box; the latent one
+//! ([`BimanualLearner::Latent`]) has `2d` orthogonal actions and a 20^d grid over a latent
+//! box given by the caller (e.g. the bounding box of the fitted latent points plus a margin).
+
+use std::sync::atomic::{AtomicBool, AtomicUsize};
+
+use latent_core::episode::{EndReason, Learner, LearnerConfig, Plant, StateSpace, StepOutcome};
+use latent_core::error::{check_finite, check_positive, CoreError, Result};
+use latent_core::policy::orthogonal_actions;
+use latent_core::trials::{run_trials, TrialOptions, TrialResult};
+use latent_core::GpMap;
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+
+/// Everything about the Experiment 1 plant; `Default` is SPEC §4.1.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BimanualConfig {
+    /// Drop tolerance on `‖(x_R − x_L) − grip‖` (SPEC default for RL: 0.1, about one RBF
+    /// spacing; Table I and the paper-strict variant: 0.005).
+    pub drop_tolerance: f64,
+    /// The held object's offset `x_R − x_L` (paper: (0.1, 0), no rotation).
+    pub grip: [f64; 2],
+    /// Centre of the disc obstacle neither hand may enter (ours: (0.5, 0.5)).
+    pub obstacle_centre: [f64; 2],
+    /// Radius of the disc obstacle (ours: 0.2); 0 removes it.
+    pub obstacle_radius: f64,
+    /// Lower bound of each hand coordinate (state box `[low, high]²` per hand; ours: −0.5).
+    pub box_low: f64,
+    /// Upper bound of each hand coordinate (ours: 1.5).
+    pub box_high: f64,
+    /// Target `x* = (x_L, y_L, x_R, y_R)` of the reward (paper: (0, 0, 0.1, 0)).
+    pub target: [f64; 4],
+    /// θ of the reward `exp(−θ ‖x − x*‖²)` (Eq. 12; paper: 0.75).
+    pub theta: f64,
+    /// Mean of the left hand's start position (paper: (1, 1)).
+    pub start_mean: [f64; 2],
+    /// Standard deviation of the left hand's start position per coordinate (paper: 0.1);
+    /// the right hand starts at left + grip.
+    pub start_sd: f64,
+    /// Penalty R_p added when a step hits the obstacle, leaves the box or drops (paper: −1).
+    pub penalty: f64,
+    /// "Reached the target": RMS per-hand distance to `x*` at most this (SPEC: 0.1).
+    pub reached_rms: f64,
+}
+
+impl Default for BimanualConfig {
+    fn default() -> Self {
+        Self {
+            drop_tolerance: 0.1,
+            grip: [0.1, 0.0],
+            obstacle_centre: [0.5, 0.5],
+            obstacle_radius: 0.2,
+            box_low: -0.5,
+            box_high: 1.5,
+            target: [0.0, 0.0, 0.1, 0.0],
+            theta: 0.75,
+            start_mean: [1.0, 1.0],
+            start_sd: 0.1,
+            penalty: -1.0,
+            reached_rms: 0.1,
+        }
+    }
+}
+
+impl BimanualConfig {
+    /// Checks every field: finite values, positive tolerances, `box_low < box_high`.
+    pub fn validate(&self) -> Result<()> {
+        check_positive("drop_tolerance", self.drop_tolerance)?;
+        check_finite("grip", &self.grip)?;
+        check_finite("obstacle_centre", &self.obstacle_centre)?;
+        check_finite("target", &self.target)?;
+        check_finite("start_mean", &self.start_mean)?;
+        check_finite("penalty", &[self.penalty])?;
+        check_positive("theta (reward width)", self.theta)?;
+        check_positive("reached_rms", self.reached_rms)?;
+        for (name, value) in [("obstacle_radius", self.obstacle_radius), ("start_sd", self.start_sd)] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(CoreError::InvalidParameter { name, value, reason: "must be finite and >= 0" });
+            }
+        }
+        check_finite("box_low/box_high", &[self.box_low, self.box_high])?;
+        if self.box_high <= self.box_low {
+            return Err(CoreError::InvalidParameter {
+                name: "box_high",
+                value: self.box_high,
+                reason: "must exceed box_low",
+            });
+        }
+        Ok(())
+    }
+
+    /// The state box as `(low, high)` corners in posture space (4-D).
+    pub fn posture_box(&self) -> ([f64; 4], [f64; 4]) {
+        ([self.box_low; 4], [self.box_high; 4])
+    }
+
+    /// Why the posture `x` would end an episode, if it would: box exit, obstacle or drop
+    /// (checked in that order).
+    pub fn violation(&self, x: &[f64]) -> Option<EndReason> {
+        if x.iter().any(|&v| v < self.box_low || v > self.box_high) {
+            return Some(EndReason::BoxExit);
+        }
+        let [cx, cy] = self.obstacle_centre;
+        let r2 = self.obstacle_radius * self.obstacle_radius;
+        let inside = |hx: f64, hy: f64| (hx - cx) * (hx - cx) + (hy - cy) * (hy - cy) < r2;
+        if inside(x[0], x[1]) || inside(x[2], x[3]) {
+            return Some(EndReason::Obstacle);
+        }
+        let dx = x[2] - x[0] - self.grip[0];
+        let dy = x[3] - x[1] - self.grip[1];
+        if dx * dx + dy * dy > self.drop_tolerance * self.drop_tolerance {
+            return Some(EndReason::Drop);
+        }
+        None
+    }
+
+    /// `R(x) = exp(−θ ‖x − x*‖²)` (paper Eq. 12).
+    pub fn reward(&self, x: &[f64]) -> f64 {
+        let d2: f64 = x.iter().zip(&self.target).map(|(a, b)| (a - b) * (a - b)).sum();
+        (-self.theta * d2).exp()
+    }
+
+    /// RMS per-hand distance to the target, `sqrt(‖x − x*‖² / 2)`.
+    pub fn rms_hand_distance(&self, x: &[f64]) -> f64 {
+        let d2: f64 = x.iter().zip(&self.target).map(|(a, b)| (a - b) * (a - b)).sum();
+        (d2 / 2.0).sqrt()
+    }
+}
+
+/// The kinematic two-hand plant of Experiment 1.
+#[derive(Debug, Clone)]
+pub struct BimanualPlant {
+    config: BimanualConfig,
+    state: [f64; 4],
+}
+
+impl BimanualPlant {
+    /// A plant with a checked configuration, both hands at the start mean.
+    pub fn new(config: BimanualConfig) -> Result<Self> {
+        config.validate()?;
+        let [x, y] = config.start_mean;
+        Ok(Self { config, state: [x, y, x + config.grip[0], y + config.grip[1]] })
+    }
+
+    /// Its configuration.
+    pub fn config(&self) -> &BimanualConfig {
+        &self.config
+    }
+
+    /// The current state `(x_L, y_L, x_R, y_R)`.
+    pub fn state(&self) -> [f64; 4] {
+        self.state
+    }
+}
+
+impl Plant for BimanualPlant {
+    fn posture_dim(&self) -> usize {
+        4
+    }
+
+    fn task_dim(&self) -> usize {
+        4
+    }
+
+    /// Left hand ~ N(start_mean, start_sd²·I), right hand = left + grip (SPEC §4.1).
+    fn sample_start<R: Rng + ?Sized>(&mut self, rng: &mut R, posture: &mut [f64]) {
+        let nx: f64 = StandardNormal.sample(rng);
+        let ny: f64 = StandardNormal.sample(rng);
+        posture[0] = self.config.start_mean[0] + self.config.start_sd * nx;
+        posture[1] = self.config.start_mean[1] + self.config.start_sd * ny;
+        posture[2] = posture[0] + self.config.grip[0];
+        posture[3] = posture[1] + self.config.grip[1];
+    }
+
+    fn reset(&mut self, posture: &[f64]) -> Option<EndReason> {
+        self.state.copy_from_slice(posture);
+        self.config.violation(posture)
+    }
+
+    /// Kinematic: the hands reach the target exactly.
+    fn step(&mut self, target: &[f64], reached: &mut [f64]) -> StepOutcome {
+        self.state.copy_from_slice(target);
+        reached.copy_from_slice(target);
+        let end = self.config.violation(target);
+        let reward = self.config.reward(target) + if end.is_some() { self.config.penalty } else { 0.0 };
+        StepOutcome { reward, end }
+    }
+
+    fn task_position(&self, out: &mut [f64]) {
+        out.copy_from_slice(&self.state);
+    }
+
+    fn reached_target(&self) -> bool {
+        self.config.rms_hand_distance(&self.state) <= self.config.reached_rms
+    }
+}
+
+/// The 12 full-space actions (SPEC §4.1): the 4 directions +x, −x, +y, −y applied to the
+/// left hand, the right hand, and both hands, as unit rows of a flat 12 × 4 array.
+pub fn full_space_actions() -> Vec<f64> {
+    let dirs = [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]];
+    let mut actions = Vec::with_capacity(48);
+    for (left, right) in [(1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+        for [dx, dy] in dirs {
+            actions.extend_from_slice(&[left * dx, left * dy, right * dx, right * dy]);
+        }
+    }
+    actions
+}
+
+/// Which learner controls the plant.
+#[derive(Debug, Clone, Copy)]
+pub enum BimanualLearner<'a> {
+    /// Full 4-D space: 12 actions, RBF grid over the plant's state box.
+    Full,
+    /// Latent space: `2d` orthogonal actions, RBF grid over `[low, high]` (d-D).
+    Latent {
+        /// Latent → posture GP map (GPLVM mean, Eq. 4).
+        decoder: &'a GpMap,
+        /// Posture → latent GP map (out-of-sample GP).
+        encoder: &'a GpMap,
+        /// Lower corner of the latent box.
+        low: &'a [f64],
+        /// Upper corner of the latent box.
+        high: &'a [f64],
+    },
+}
+
+impl<'a> BimanualLearner<'a> {
+    /// The learner (box, actions, fresh weights) and its state space for `plant`.
+    pub fn build(&self, plant: &BimanualConfig, config: &LearnerConfig) -> Result<(Learner, StateSpace<'a>)> {
+        plant.validate()?;
+        match *self {
+            Self::Full => {
+                let (low, high) = plant.posture_box();
+                Ok((Learner::new(config, &low, &high, &full_space_actions())?, StateSpace::Full))
+            }
+            Self::Latent { decoder, encoder, low, high } => {
+                let learner = Learner::new(config, low, high, &orthogonal_actions(low.len()))?;
+                let space = StateSpace::Latent { decoder, encoder };
+                learner.check_space(&space, 4)?;
+                Ok((learner, space))
+            }
+        }
+    }
+}
+
+/// Runs Experiment 1 trials (SPEC §4.1) in parallel: see
+/// [`latent_core::trials::run_trials`] for seeding, cancellation and progress.
+pub fn run_bimanual_trials(
+    plant: &BimanualConfig,
+    config: &LearnerConfig,
+    learner: &BimanualLearner<'_>,
+    options: &TrialOptions,
+    cancel: &AtomicBool,
+    done: &AtomicUsize,
+) -> Result<Vec<TrialResult>> {
+    let (template, space) = learner.build(plant, config)?;
+    run_trials(&template, &space, |_| BimanualPlant::new(*plant), options, cancel, done)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn violations_and_reward() {
+        let c = BimanualConfig::default();
+        assert_eq!(c.violation(&[1.0, 1.0, 1.1, 1.0]), None);
+        assert_eq!(c.violation(&[0.5, 0.45, 0.6, 0.45]), Some(EndReason::Obstacle));
+        assert_eq!(c.violation(&[0.2, 0.5, 0.3, 0.5]), None, "left hand 0.3 from the centre, right 0.2: on the rim");
+        assert_eq!(c.violation(&[1.45, 1.0, 1.55, 1.0]), Some(EndReason::BoxExit));
+        assert_eq!(c.violation(&[1.0, 1.0, 1.25, 1.0]), Some(EndReason::Drop));
+        assert_eq!(c.violation(&[1.0, 1.0, 1.19, 1.0]), None, "within the 0.1 tolerance");
+        let strict = BimanualConfig { drop_tolerance: 0.005, ..c };
+        assert_eq!(strict.violation(&[1.0, 1.0, 1.11, 1.0]), Some(EndReason::Drop));
+        assert_eq!(c.reward(&c.target), 1.0);
+        assert!((c.reward(&[1.0, 1.0, 1.1, 1.0]) - (-3.0f64).exp()).abs() < 1e-15);
+        assert!((c.rms_hand_distance(&[0.1, 0.0, 0.2, 0.0]) - 0.1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn step_adds_the_penalty_and_reports_the_end() {
+        let mut p = BimanualPlant::new(BimanualConfig::default()).unwrap();
+        let mut reached = [0.0; 4];
+        let ok = p.step(&[1.0, 1.0, 1.1, 1.0], &mut reached);
+        assert_eq!(reached, [1.0, 1.0, 1.1, 1.0]);
+        assert_eq!(ok.end, None);
+        let dropped = p.step(&[1.0, 1.0, 1.3, 1.0], &mut reached);
+        assert_eq!(dropped.end, Some(EndReason::Drop));
+        assert!((dropped.reward - (p.config().reward(&[1.0, 1.0, 1.3, 1.0]) - 1.0)).abs() < 1e-15);
+        assert!(!p.reached_target());
+        p.step(&[0.05, 0.0, 0.15, 0.0], &mut reached);
+        assert!(p.reached_target());
+    }
+
+    #[test]
+    fn starts_hold_the_object_around_1_1() {
+        let mut p = BimanualPlant::new(BimanualConfig::default()).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let mut x = [0.0; 4];
+        let mut mean = [0.0; 2];
+        for _ in 0..2000 {
+            p.sample_start(&mut rng, &mut x);
+            assert_eq!(p.reset(&x), None);
+            assert!(((x[2] - x[0]) - 0.1).abs() < 1e-12 && (x[3] - x[1]).abs() < 1e-12);
+            mean[0] += x[0] / 2000.0;
+            mean[1] += x[1] / 2000.0;
+        }
+        assert!((mean[0] - 1.0).abs() < 0.01 && (mean[1] - 1.0).abs() < 0.01, "{mean:?}");
+    }
+
+    #[test]
+    fn twelve_distinct_unit_actions() {
+        let a = full_space_actions();
+        assert_eq!(a.len(), 48);
+        let rows: Vec<&[f64]> = a.chunks_exact(4).collect();
+        for (i, r) in rows.iter().enumerate() {
+            assert!(r.iter().any(|&v| v != 0.0));
+            assert!(rows[..i].iter().all(|o| o != r));
+        }
+        // "Both hands" moves keep the grip.
+        for r in &rows[8..] {
+            assert_eq!(r[0], r[2]);
+            assert_eq!(r[1], r[3]);
+        }
+    }
+
+    #[test]
+    fn full_learner_step_is_0_021() {
+        let (learner, _) = BimanualLearner::Full.build(&BimanualConfig::default(), &LearnerConfig::default()).unwrap();
+        assert_eq!(learner.grid().len(), 160_000);
+        let d = learner.displacements();
+        assert!((d[0] - 0.2 * 2.0 / 19.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn bad_config_is_an_error() {
+        for c in [
+            BimanualConfig { drop_tolerance: 0.0, ..Default::default() },
+            BimanualConfig { box_high: -1.0, ..Default::default() },
+            BimanualConfig { start_sd: -0.1, ..Default::default() },
+            BimanualConfig { target: [f64::NAN, 0.0, 0.0, 0.0], ..Default::default() },
+        ] {
+            assert!(BimanualPlant::new(c).is_err());
+        }
+    }
+}

@@ -1,0 +1,169 @@
+"""One runner for every RL experiment (SPEC §5): seed, build the learners, run the trials in
+chunks, save after each chunk, draw the figures.
+
+A results directory that already holds a run of the same preset is continued: finished
+trials are kept and only the missing ones run (the trials' seeds depend on the base seed
+and the trial index alone, so the result equals an uninterrupted run). A different preset
+in the same directory is an error.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+from tqdm import tqdm
+
+from latentrl.experiments.presets import describe
+from latentrl.experiments.results import environment, read_json, write_json, write_npz
+
+END_CODES = {0: "timeout", 1: "obstacle", 2: "box_exit", 3: "drop", 4: "fall", 5: "variance_gate"}
+"""How an episode ended, as stored in `<learner>_end` (−1: not run)."""
+
+PER_EPISODE = {"returns": "", "ends": "_end", "steps": "_steps", "reached": "_reached"}
+"""Per-episode arrays of the native call, each (trials, episodes), and the suffix of their
+key in returns.npz after the learner's name (SPEC §5: `latent`, `latent_end`, …)."""
+
+
+def array_key(learner: str, what: str) -> str:
+    """Key in returns.npz of a learner's per-episode array `what` (see PER_EPISODE)."""
+    return learner + PER_EPISODE[what]
+
+#: A learner: runs trials `first .. first + n` and returns the native call's dict.
+RunTrials = Callable[..., dict[str, Any]]
+
+
+class Preset(Protocol):
+    """What the runner needs of a preset."""
+
+    trials: int
+    episodes: int
+    seed: int
+
+
+@dataclass
+class Setup:
+    """What an experiment builds before its trials: learners by name, and facts to record."""
+
+    learners: dict[str, RunTrials]
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+def run_rl(
+    preset: Preset,
+    out_dir: Path | str,
+    *,
+    setup: Callable[[Any], Setup],
+    figures: Callable[[Any, Mapping[str, np.ndarray], Path], None],
+    progress: bool = True,
+    chunk: int | None = None,
+) -> dict[str, Any]:
+    """Runs (or continues) `preset` into `out_dir`; returns the metadata written to results.json."""
+    out = Path(out_dir)
+    meta_path, arrays_path = out / "results.json", out / "returns.npz"
+    plan = describe(preset)
+    arrays, meta = _previous(meta_path, arrays_path, plan)
+    started = time.perf_counter()
+    built = setup(preset)
+    chunk = chunk or max(os.cpu_count() or 1, 1)
+    if meta is None:
+        meta = {"preset": plan, "environment": environment(), "setup": built.info, "wall_time_s": 0.0}
+    for name in built.learners:
+        for key in PER_EPISODE:
+            arrays.setdefault(array_key(name, key), _empty(key, preset.trials, preset.episodes))
+    todo = [
+        (name, t)
+        for name in built.learners
+        for t in range(preset.trials)
+        if arrays[array_key(name, "ends")][t, 0] < 0
+    ]
+    bar = tqdm(total=len(todo) * preset.episodes, unit="ep", disable=not progress, desc="episodes")
+    meta.setdefault("trials", {})
+    try:
+        for name, first, n in _chunks(todo, chunk):
+            done_before = bar.n
+
+            def report(done: int, _total: int, base: int = done_before) -> None:
+                bar.update(base + done - bar.n)
+
+            result = built.learners[name](first_trial=first, n_trials=n, progress=report)
+            for i, t in enumerate(range(first, first + n)):
+                for key in PER_EPISODE:
+                    arrays[array_key(name, key)][t] = result[key][i]
+                if "trajectories" in result:
+                    arrays.setdefault(
+                        f"{name}_paths", np.full((preset.trials, *result["trajectories"].shape[1:]), np.nan)
+                    )[t] = result["trajectories"][i]
+                meta["trials"].setdefault(name, {})[str(t)] = summarise_trial(arrays, name, t)
+            meta["wall_time_s"] += time.perf_counter() - started
+            started = time.perf_counter()
+            _save(meta_path, arrays_path, meta, arrays)
+    finally:
+        bar.close()
+    figures(preset, arrays, out)
+    return meta
+
+
+def summarise_trial(arrays: Mapping[str, np.ndarray], name: str, trial: int) -> dict[str, Any]:
+    """Per-trial figures for results.json: early/late mean return, end counts, reach rate."""
+    returns = arrays[array_key(name, "returns")][trial]
+    ends = arrays[array_key(name, "ends")][trial]
+    reached = arrays[array_key(name, "reached")][trial]
+    window = max(1, len(returns) // 10)
+    return {
+        "mean_return_first": float(returns[:window].mean()),
+        "mean_return_last": float(returns[-window:].mean()),
+        "reached_last": float(reached[-window:].mean()),
+        "window": window,
+        "ends": {label: int((ends == code).sum()) for code, label in END_CODES.items()},
+    }
+
+
+def _empty(key: str, trials: int, episodes: int) -> np.ndarray:
+    if key == "returns":
+        return np.full((trials, episodes), np.nan)
+    if key == "ends":
+        return np.full((trials, episodes), -1, dtype=np.int8)
+    if key == "reached":
+        return np.zeros((trials, episodes), dtype=bool)
+    return np.zeros((trials, episodes), dtype=np.int64)
+
+
+def _chunks(todo: list[tuple[str, int]], size: int) -> list[tuple[str, int, int]]:
+    """Consecutive runs of the same learner, at most `size` trials each: (name, first, count)."""
+    out: list[tuple[str, int, int]] = []
+    for name, t in todo:
+        if out and out[-1][0] == name and out[-1][1] + out[-1][2] == t and out[-1][2] < size:
+            out[-1] = (name, out[-1][1], out[-1][2] + 1)
+        else:
+            out.append((name, t, 1))
+    return out
+
+
+def _previous(
+    meta_path: Path, arrays_path: Path, plan: dict[str, Any]
+) -> tuple[dict[str, np.ndarray], dict[str, Any] | None]:
+    """Arrays and metadata of an earlier run of the same preset in this directory, if any."""
+    if not meta_path.exists():
+        return {}, None
+    meta = read_json(meta_path)
+    if meta.get("preset") != plan:
+        raise ValueError(
+            f"{meta_path.parent} holds a run of a different preset; choose another --out "
+            "or delete it (only a run of the same preset is continued)"
+        )
+    if not arrays_path.exists():
+        return {}, None
+    with np.load(arrays_path, allow_pickle=False) as npz:
+        return {k: npz[k] for k in npz.files}, meta
+
+
+def _save(meta_path: Path, arrays_path: Path, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+    # Arrays first: a crash between the two leaves metadata that under-reports, never over-reports.
+    write_npz(arrays_path, arrays)
+    write_json(meta_path, meta)
