@@ -18,7 +18,7 @@ import numpy as np
 
 from latentrl import _native
 from latentrl.datasets import bimanual_pairs
-from latentrl.experiments.presets import latent_box
+from latentrl.experiments.presets import check_floats, check_ints, latent_box
 from latentrl.experiments.runner import Setup, run_rl
 from latentrl.gplvm import GPLVM
 from latentrl.plots import hand_paths, learning_curves, save_figure
@@ -73,6 +73,22 @@ class Exp1Preset:
     """Latent targets with GPLVM variance above this are infeasible (−1, end); 0 = off (SPEC §3.2)."""
     reach_radius: float = 0.1
     """'Reached the target': RMS per-hand distance to x* at most this (SPEC §4.1)."""
+
+    def validate(self) -> None:
+        """ValueError naming the first field with an impossible value."""
+        check_ints(self, ("trials", "episodes", "steps", "n_demos", "gplvm_max_iter", "rbf_per_dim"))
+        check_ints(self, ("seed",), minimum=0)
+        check_floats(
+            self,
+            ("drop_tolerance", "reward_theta", "start_std", "rbf_cutoff", "beta", "alpha",
+             "step_fraction", "reach_radius"),
+            positive=True,
+        )
+        check_floats(self, ("latent_margin", "obstacle_radius", "variance_threshold"), positive=False)
+        if not np.isfinite(self.initial_weight):
+            raise ValueError(f"initial_weight must be finite, got {self.initial_weight!r}")
+        if not 0 <= self.gamma < 1:
+            raise ValueError(f"gamma must lie in [0, 1), got {self.gamma!r}")
 
     @classmethod
     def quick(cls) -> Exp1Preset:

@@ -40,3 +40,21 @@ def latent_box(latent: np.ndarray, margin: float) -> tuple[np.ndarray, np.ndarra
     low, high = latent.min(axis=0), latent.max(axis=0)
     pad = margin * (high - low)
     return low - pad, high + pad
+
+
+def check_ints(preset: Any, names: tuple[str, ...], minimum: int = 1) -> None:
+    """ValueError naming the first of `names` that is not an int >= `minimum`."""
+    for name in names:
+        value = getattr(preset, name)
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+            raise ValueError(f"{name} must be an int >= {minimum}, got {value!r}")
+
+
+def check_floats(preset: Any, names: tuple[str, ...], *, positive: bool) -> None:
+    """ValueError naming the first of `names` that is not finite and > 0 (or >= 0)."""
+    for name in names:
+        value = getattr(preset, name)
+        ok = isinstance(value, (int, float, np.integer, np.floating)) and np.isfinite(value)
+        if not ok or value < 0 or (positive and value == 0):
+            bound = "> 0" if positive else ">= 0"
+            raise ValueError(f"{name} must be a finite number {bound}, got {value!r}")

@@ -45,6 +45,9 @@ class Preset(Protocol):
     episodes: int
     seed: int
 
+    def validate(self) -> None:
+        """ValueError naming the first impossible field."""
+
 
 @dataclass
 class Setup:
@@ -64,6 +67,7 @@ def run_rl(
     chunk: int | None = None,
 ) -> dict[str, Any]:
     """Runs (or continues) `preset` into `out_dir`; returns the metadata written to results.json."""
+    preset.validate()
     out = Path(out_dir)
     meta_path, arrays_path = out / "results.json", out / "returns.npz"
     plan = describe(preset)

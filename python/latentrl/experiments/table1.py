@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from latentrl.datasets import arm_postures, arms_forward, bimanual_pairs, grip_error
-from latentrl.experiments.presets import describe
+from latentrl.experiments.presets import check_floats, check_ints, describe
 from latentrl.experiments.results import environment, write_atomic, write_json
 
 SPACES = ("end_effector", "joint")
@@ -105,33 +105,19 @@ class Table1Preset:
 
     def validate(self) -> None:
         """ValueError naming the first field with an impossible value."""
-        for name in (
-            "trials",
-            "n_demos_ee",
-            "n_demos_joint",
-            "n_test",
-            "n_latent_samples",
-            "gplvm_max_iter",
-        ):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise ValueError(f"{name} must be an int >= 1, got {value!r}")
+        check_ints(
+            self,
+            ("trials", "n_demos_ee", "n_demos_joint", "n_test", "n_latent_samples", "gplvm_max_iter"),
+        )
         if not isinstance(self.n_components, int) or not 1 <= self.n_components < 4:
             raise ValueError(
                 f"n_components must be 1, 2 or 3 (the data is 4-D), got {self.n_components!r}"
             )
-        for name in ("tolerance", "gplvm_noise_floor", "variant_noise_floor"):
-            if not (np.isfinite(getattr(self, name)) and getattr(self, name) > 0):
-                raise ValueError(f"{name} must be a finite number > 0, got {getattr(self, name)!r}")
-        nonnegative = {
-            "ee_noise": self.ee_noise,
-            "joint_noise": self.joint_noise,
-            "latent_margin": self.latent_margin,
-        }
-        nonnegative.update({f"variant_margins[{i}]": m for i, m in enumerate(self.variant_margins)})
-        for name, value in nonnegative.items():
-            if not (np.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+        check_floats(self, ("tolerance", "gplvm_noise_floor", "variant_noise_floor"), positive=True)
+        check_floats(self, ("ee_noise", "joint_noise", "latent_margin"), positive=False)
+        for i, margin in enumerate(self.variant_margins):
+            if not (np.isfinite(margin) and margin >= 0):
+                raise ValueError(f"variant_margins[{i}] must be a finite number >= 0, got {margin!r}")
         if self.constraint_test not in TESTS:
             raise ValueError(
                 f"constraint_test must be one of {TESTS}, got {self.constraint_test!r}"
@@ -140,8 +126,7 @@ class Table1Preset:
             raise ValueError(
                 f"encode_method must be 'gp' or 'projection', got {self.encode_method!r}"
             )
-        if isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 0:
-            raise ValueError(f"workers must be an int >= 0, got {self.workers!r}")
+        check_ints(self, ("workers",), minimum=0)
 
     def margins(self) -> tuple[float, ...]:
         """Every latent margin evaluated: the table's and, with `variants`, the variants'."""

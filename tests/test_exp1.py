@@ -1,0 +1,107 @@
+"""Experiment 1 end to end: the quick preset learns, results follow SPEC §5, runs resume."""
+
+import dataclasses
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from latentrl.experiments import exp1
+from latentrl.experiments.exp1 import Exp1Preset, run_exp1
+from latentrl.experiments.runner import run_rl
+
+TINY = dataclasses.replace(Exp1Preset.quick(), trials=2, episodes=40, steps=100)
+
+
+@pytest.fixture(scope="module")
+def quick_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("exp1_quick")
+    meta = run_exp1(Exp1Preset.quick(), out, progress=False)
+    return out, meta
+
+
+def test_quick_preset_latent_learner_learns_and_never_drops(quick_run):
+    out, _ = quick_run
+    with np.load(out / "returns.npz") as npz:
+        latent, latent_end, full = npz["latent"], npz["latent_end"], npz["full"]
+    first, last = latent[:, :50].mean(axis=1), latent[:, -50:].mean(axis=1)
+    # SPEC §4.1 (NumPy study): last/first 3.0–3.5×, last ≈ 223–266 per seed.
+    assert np.all(last > 2.5 * first), (first, last)
+    assert np.all(last > 150), last
+    assert not np.any(latent_end == 3), "the latent learner dropped the object"
+    assert np.all(full[:, -50:].mean(axis=1) < 0.2 * last)
+
+
+def test_results_layout_follows_spec(quick_run):
+    out, meta = quick_run
+    saved = json.loads((out / "results.json").read_text())
+    preset = Exp1Preset.quick()
+    assert saved["preset"] == {"name": "Exp1Preset", **dataclasses.asdict(preset)}
+    assert saved["environment"]["versions"]["numpy"] == np.__version__
+    assert saved["wall_time_s"] > 0 and set(saved["trials"]) == {"latent", "full"}
+    with np.load(out / "returns.npz") as npz:
+        for name in ("latent", "full"):
+            assert npz[name].shape == npz[f"{name}_end"].shape == (preset.trials, preset.episodes)
+            assert np.isfinite(npz[name]).all() and set(np.unique(npz[f"{name}_end"])) <= {0, 1, 2, 3}
+    for fig in ("fig4a", "fig4b", "fig4c"):
+        for ext in ("png", "pdf"):
+            assert (out / f"{fig}.{ext}").stat().st_size > 1000
+    assert not list(out.glob(".*tmp")), "temporary files left behind"
+
+
+def test_same_seed_same_returns_and_other_seed_differs(tmp_path):
+    a = run_exp1(TINY, tmp_path / "a", progress=False)
+    b = run_exp1(TINY, tmp_path / "b", progress=False)
+    c = run_exp1(dataclasses.replace(TINY, seed=1), tmp_path / "c", progress=False)
+    assert a["trials"] == b["trials"] != c["trials"]
+
+
+def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
+    run_exp1(TINY, tmp_path / "whole", progress=False)
+    calls = {"n": 0}
+
+    def interrupting_setup(preset):
+        built = exp1.setup(preset)
+        inner = built.learners["full"]
+
+        def full(**kwargs):
+            calls["n"] += 1
+            if calls["n"] == 2:
+                raise KeyboardInterrupt
+            return inner(**kwargs)
+
+        built.learners["full"] = full
+        return built
+
+    with pytest.raises(KeyboardInterrupt):
+        run_rl(TINY, tmp_path / "part", setup=interrupting_setup, figures=exp1.figures, chunk=1, progress=False)
+    with np.load(tmp_path / "part" / "returns.npz") as npz:
+        assert (npz["full_end"][1] == -1).all() and (npz["full_end"][0] >= 0).all()
+    run_exp1(TINY, tmp_path / "part", progress=False)
+    with np.load(tmp_path / "whole" / "returns.npz") as whole, np.load(tmp_path / "part" / "returns.npz") as part:
+        for key in whole.files:
+            np.testing.assert_array_equal(whole[key], part[key], err_msg=key)
+
+
+def test_a_different_preset_in_the_same_directory_is_refused(tmp_path):
+    run_exp1(TINY, tmp_path, progress=False)
+    with pytest.raises(ValueError, match="different preset"):
+        run_exp1(dataclasses.replace(TINY, beta=5.0), tmp_path, progress=False)
+
+
+def test_thread_count_does_not_change_results(tmp_path):
+    arrays = []
+    for threads in ("1", "2"):
+        out = tmp_path / threads
+        env = {**os.environ, "RAYON_NUM_THREADS": threads}
+        cmd = [sys.executable, "-m", "latentrl", "run", "exp1", "--quick", "--no-progress",
+               "--trials", "2", "--episodes", "40", "--steps", "100", "--out", str(out)]
+        subprocess.run(cmd, env=env, check=True, capture_output=True, timeout=300)
+        with np.load(out / "returns.npz") as npz:
+            arrays.append({k: npz[k] for k in npz.files})
+    assert arrays[0].keys() == arrays[1].keys()
+    for key in arrays[0]:
+        np.testing.assert_array_equal(arrays[0][key], arrays[1][key], err_msg=key)
