@@ -22,8 +22,9 @@ $(VENV)/.built: $(VENV)/.deps Cargo.toml Cargo.lock $(shell find crates python -
 
 build: $(VENV)/.built ## create the venv, install deps, build the native module
 
-demo: build ## reproduce Table I (paper) on defaults and print it
+demo: build ## reproduce Table I and Experiment 1 (Fig. 4) on defaults into results/
 	$(PY) -m latentrl run table1 --out results/table1
+	$(PY) -m latentrl run exp1 --out results/exp1
 
 test: build ## Rust tests (pure crates) and the default pytest run
 	cargo test --quiet
@@ -33,9 +34,16 @@ test-all: build ## everything, slow reproductions included
 	cargo test --quiet
 	$(PY) -m pytest -q -m ''
 
-bench: build ## criterion benches and the Python peer comparison (JSON in benches/results/)
-	cargo bench -p latent_core
-	$(PY) benches/bench_gp.py
+bench: build ## criterion benches, the NumPy loop and GPy comparisons (JSON in benches/results/)
+	cargo bench -p latent_core -p sim
+	$(PY) benches/bench_td.py
+	bash benches/setup_bench_env.sh
+	benches/.venv-bench/bin/python benches/bench_gp.py
+
+lint: build ## clippy (warnings are errors) and the native stubs against the module
+	cargo clippy --workspace --all-targets -- -D warnings
+	$(PY) -m pip install --quiet mypy
+	$(PY) -m mypy.stubtest latentrl._native
 
 clean: ## remove the venv and build outputs
 	rm -rf $(VENV) target

@@ -54,3 +54,16 @@ def test_unknown_flag_exits_2():
     with pytest.raises(SystemExit) as exit_info:
         main(["run", "exp1", "--no-such-flag"])
     assert exit_info.value.code == 2
+
+
+@pytest.mark.parametrize("script", ["table1.py", "exp1.py"])
+def test_examples_run_quick(script, tmp_path):
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "examples" / script
+    result = subprocess.run(
+        [sys.executable, str(path), "--quick", "--out", str(tmp_path)],
+        capture_output=True, text=True, timeout=300,
+    )
+    assert result.returncode == 0, result.stderr
+    assert any(tmp_path.iterdir())

@@ -51,3 +51,24 @@ def gplvm_nll_grad(latent: Array, centred: Array, log_theta: Array) -> tuple[flo
         [np.sum(g * k_se), np.sum(g * k_se * r2) / (2 * theta[1]), theta[2] * np.trace(g)]
     )
     return float(nll), grad_latent, grad_log_theta
+
+
+def rbf_centres(low: Array, high: Array, per_dim: int) -> tuple[Array, Array]:
+    """Centres (per_dim^d, d) of a regular grid over the box [low, high], corners included,
+    and the grid spacing (d,)."""
+    axes = [np.linspace(lo, hi, per_dim) for lo, hi in zip(low, high)]
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, len(low))
+    return grid, (np.asarray(high) - np.asarray(low)) / (per_dim - 1)
+
+
+def rbf_features(state: Array, centres: Array, sigma: Array) -> Array:
+    """Dense normalised RBFs `b_i = φ_i / Σ_j φ_j`, `φ_i = exp(−½ Σ_k ((s_k − c_ik)/σ_k)²)`."""
+    phi = np.exp(-0.5 * np.sum(((state - centres) / sigma) ** 2, axis=-1))
+    return phi / phi.sum()
+
+
+def td0_update(weights: Array, b: Array, reward: float, v_next: float, alpha: float, gamma: float) -> float:
+    """Eq. 7–9 in place: `δ = r + γ V(s') − V(s)`, `w += α δ b(s)`; `v_next` = 0 if terminal."""
+    delta = reward + gamma * v_next - weights @ b
+    weights += alpha * delta * b
+    return float(delta)

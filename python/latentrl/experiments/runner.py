@@ -25,14 +25,34 @@ from latentrl.experiments.results import environment, read_json, write_json, wri
 END_CODES = {0: "timeout", 1: "obstacle", 2: "box_exit", 3: "drop", 4: "fall", 5: "variance_gate"}
 """How an episode ended, as stored in `<learner>_end` (−1: not run)."""
 
-PER_EPISODE = {"returns": "", "ends": "_end", "steps": "_steps", "reached": "_reached"}
+PER_EPISODE = {
+    "returns": "",
+    "ends": "_end",
+    "steps": "_steps",
+    "reached": "_reached",
+    "passed": "_passed",
+}
 """Per-episode arrays of the native call, each (trials, episodes), and the suffix of their
 key in returns.npz after the learner's name (SPEC §5: `latent`, `latent_end`, …)."""
 
+PER_TRIAL = {
+    "test_returns": "_test",
+    "test_ends": "_test_end",
+    "test_steps": "_test_steps",
+    "test_reached": "_test_reached",
+    "test_passed": "_test_passed",
+    "trajectories": "_paths",
+    "test_trajectories": "_test_paths",
+    "weights": "_weights",
+}
+"""Further per-trial arrays of the native call (frozen test episodes (trials, K), recorded
+paths, final weights) and their suffix in returns.npz; stored when the call returns them
+with a non-empty per-trial part."""
+
 
 def array_key(learner: str, what: str) -> str:
-    """Key in returns.npz of a learner's per-episode array `what` (see PER_EPISODE)."""
-    return learner + PER_EPISODE[what]
+    """Key in returns.npz of a learner's array `what` (see PER_EPISODE and PER_TRIAL)."""
+    return learner + {**PER_EPISODE, **PER_TRIAL}[what]
 
 #: A learner: runs trials `first .. first + n` and returns the native call's dict.
 RunTrials = Callable[..., dict[str, Any]]
@@ -99,10 +119,10 @@ def run_rl(
             for i, t in enumerate(range(first, first + n)):
                 for key in PER_EPISODE:
                     arrays[array_key(name, key)][t] = result[key][i]
-                if "trajectories" in result:
-                    arrays.setdefault(
-                        f"{name}_paths", np.full((preset.trials, *result["trajectories"].shape[1:]), np.nan)
-                    )[t] = result["trajectories"][i]
+                for key in PER_TRIAL:
+                    value = result.get(key)
+                    if value is not None and value[i].size:
+                        arrays.setdefault(array_key(name, key), _unset(value, preset.trials))[t] = value[i]
                 meta["trials"].setdefault(name, {})[str(t)] = summarise_trial(arrays, name, t)
             meta["wall_time_s"] += time.perf_counter() - started
             started = time.perf_counter()
@@ -114,18 +134,35 @@ def run_rl(
 
 
 def summarise_trial(arrays: Mapping[str, np.ndarray], name: str, trial: int) -> dict[str, Any]:
-    """Per-trial figures for results.json: early/late mean return, end counts, reach rate."""
+    """Per-trial figures for results.json: early/late mean return, end counts, reach and pass
+    rates; with frozen test episodes also `test_success` (share that reached the target),
+    `test_passed`, their mean return and end counts."""
     returns = arrays[array_key(name, "returns")][trial]
     ends = arrays[array_key(name, "ends")][trial]
     reached = arrays[array_key(name, "reached")][trial]
+    passed = arrays[array_key(name, "passed")][trial]
     window = max(1, len(returns) // 10)
-    return {
+    summary: dict[str, Any] = {
         "mean_return_first": float(returns[:window].mean()),
         "mean_return_last": float(returns[-window:].mean()),
         "reached_last": float(reached[-window:].mean()),
+        "passed_last": float(passed[-window:].mean()),
         "window": window,
-        "ends": {label: int((ends == code).sum()) for code, label in END_CODES.items()},
+        "ends": _end_counts(ends),
     }
+    if array_key(name, "test_ends") in arrays:
+        test_ends = arrays[array_key(name, "test_ends")][trial]
+        summary.update(
+            test_success=float(arrays[array_key(name, "test_reached")][trial].mean()),
+            test_passed=float(arrays[array_key(name, "test_passed")][trial].mean()),
+            test_mean_return=float(arrays[array_key(name, "test_returns")][trial].mean()),
+            test_ends=_end_counts(test_ends),
+        )
+    return summary
+
+
+def _end_counts(ends: np.ndarray) -> dict[str, int]:
+    return {label: int((ends == code).sum()) for code, label in END_CODES.items()}
 
 
 def _empty(key: str, trials: int, episodes: int) -> np.ndarray:
@@ -136,6 +173,17 @@ def _empty(key: str, trials: int, episodes: int) -> np.ndarray:
     if key == "reached":
         return np.zeros((trials, episodes), dtype=bool)
     return np.zeros((trials, episodes), dtype=np.int64)
+
+
+def _unset(value: np.ndarray, trials: int) -> np.ndarray:
+    """A (trials, …) array for per-trial rows like `value[i]`, every entry 'not run':
+    NaN (floats), −1 (ints), False (bools)."""
+    shape = (trials, *value.shape[1:])
+    if value.dtype == bool:
+        return np.zeros(shape, dtype=bool)
+    if np.issubdtype(value.dtype, np.integer):
+        return np.full(shape, -1, dtype=value.dtype)
+    return np.full(shape, np.nan, dtype=value.dtype)
 
 
 def _chunks(todo: list[tuple[str, int]], size: int) -> list[tuple[str, int, int]]:

@@ -1,0 +1,138 @@
+"""The humanoid fall check (SPEC §4.3, paper Fig. 7a): does decoding the lift demos through
+PCA or the GPLVM (d = 2) keep the KHR-1HV-like robot balanced and the grip closed?
+
+For each method — PCA, GPLVM, and plain joint interpolation (the control) — the check
+
+1. decodes every demo pose (encode → decode; the control returns the demo), clips it to
+   the joint limits, stands the robot in it and holds it for `pose_hold` s;
+2. walks straight lines between consecutive demos *within one style* (in latent space for
+   PCA and the GPLVM, in joint space for the control): `path_points` targets per line,
+   each held `path_hold` s, starting from the decoded first pose.
+
+Each row reports the rms and largest joint error (deg; paths: against joint interpolation
+at the same fraction), the kinematic grip error and support margin of the decoded pose(s)
+(NumPy FK, statically placed), and the simulated smallest support margin, largest
+|grip error| and whether it fell (Rust, rapier). PCA falls are reported as observed: the
+effect depends on how close to the heel the demos balance (docs/humanoid.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl.demos import load_demos
+from latentrl.gplvm import GPLVM
+from latentrl.humanoid import demos_path, fall_check, model
+from latentrl.pca import PCA
+
+#: Style of each row of the shipped demo files: 4 straight-arm hip-hinge + 3 knee-squat poses.
+STYLES = (0, 0, 0, 0, 1, 1, 1)
+METHODS = ("PCA", "GPLVM", "joint")
+
+
+@dataclass(frozen=True)
+class FallCheckPreset:
+    """Parameters of the fall check (our choices; the paper gives none)."""
+
+    demos: str | None = None
+    """Demo file; None = the shipped heel-side set (CoM 2 cm ahead of the heels)."""
+    styles: tuple[int, ...] = STYLES
+    """Style label of each demo; latent lines never cross styles."""
+    pose_hold: float = 2.0
+    """Seconds each decoded demo pose is held (the demos themselves hold ≥ 2 s)."""
+    path_points: int = 6
+    """Targets per straight line between consecutive demos (end points included)."""
+    path_hold: float = 0.25
+    """Seconds each target of a line is held."""
+    random_state: int = 0
+    """Seed of the GPLVM fit."""
+
+
+def _rms_max(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[float, float]:
+    d = np.degrees(a - b)
+    return float(np.sqrt(np.mean(d**2))), float(np.abs(d).max())
+
+
+def run_fallcheck(preset: FallCheckPreset | None = None) -> list[dict[str, Any]]:
+    """Runs the check; one dict per (method, pose or line) with the keys of `COLUMNS`."""
+    p = preset or FallCheckPreset()
+    h = model()
+    demos = load_demos(
+        Path(p.demos) if p.demos else demos_path(heel=True), expected_joints=h.joint_names
+    )
+    X = demos.postures
+    if len(p.styles) != len(X):
+        raise ValueError(f"styles: {len(p.styles)} labels for {len(X)} demos")
+    pca = PCA(n_components=2).fit(X)
+    gplvm = GPLVM(n_components=2, random_state=p.random_state).fit(X)
+    coders: dict[str, tuple[Any, Any]] = {
+        "PCA": (pca.transform(X), pca.inverse_transform),
+        "GPLVM": (gplvm.Z_, gplvm.inverse_transform),
+        "joint": (X, lambda z: np.asarray(z, dtype=float)),
+    }
+
+    def decode(method: str, z: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.clip(coders[method][1](np.atleast_2d(z)), h.lower, h.upper)
+
+    rows: list[dict[str, Any]] = []
+    for method in METHODS:
+        latent = coders[method][0]
+        for i in range(len(X)):
+            pose = decode(method, latent[i])[0]
+            sim = fall_check(pose, pose[None], hold=p.pose_hold)[0]
+            rows.append(_row(method, f"pose {i}", pose[None], X[i][None], sim[None], h))
+        for i in range(len(X) - 1):
+            if p.styles[i] != p.styles[i + 1]:
+                continue
+            s = np.linspace(0.0, 1.0, p.path_points)[:, None]
+            targets = decode(method, (1 - s) * latent[i] + s * latent[i + 1])
+            control = (1 - s) * X[i] + s * X[i + 1]
+            sim = fall_check(targets[0], targets, hold=p.path_hold)
+            rows.append(_row(method, f"line {i}-{i + 1}", targets, control, sim, h))
+    return rows
+
+
+#: Keys of every row of `run_fallcheck`.
+COLUMNS = (
+    "method", "segment", "rms_deg", "max_deg", "grip_error", "margin", "sim_margin",
+    "sim_grip_error", "fell",
+)
+
+
+def _row(method: str, segment: str, poses: NDArray[np.float64], reference: NDArray[np.float64],
+         sim: NDArray[np.float64], h: Any) -> dict[str, Any]:
+    balance = [h.balance(q) for q in poses]
+    rms, worst = _rms_max(poses, reference)
+    grips = [b["grip_error"] for b in balance]
+    return {
+        "method": method,
+        "segment": segment,
+        "rms_deg": rms,
+        "max_deg": worst,
+        "grip_error": float(grips[int(np.argmax(np.abs(grips)))]),
+        "margin": float(min(b["margin"] for b in balance)),
+        "sim_margin": float(sim[:, 1].min()),
+        "sim_grip_error": float(sim[:, 4].max()),
+        "fell": bool(sim[:, 0].max() > 0.5),
+    }
+
+
+def format_table(rows: Sequence[dict[str, Any]]) -> str:
+    """A Markdown table of `rows` (lengths in mm, angles in degrees)."""
+    head = ("| method | segment | rms joint err (°) | max (°) | grip err (mm) | margin (mm) "
+            "| sim min margin (mm) | sim max grip err (mm) | fell |")
+    lines = [head, "|" + "---|" * 9]
+    for r in rows:
+        lines.append(
+            f"| {r['method']} | {r['segment']} | {r['rms_deg']:.2f} | {r['max_deg']:.1f} "
+            f"| {1e3 * r['grip_error']:+.1f} | {1e3 * r['margin']:.1f} "
+            f"| {1e3 * r['sim_margin']:.1f} "
+            f"| {1e3 * r['sim_grip_error']:.1f} | {'yes' if r['fell'] else 'no'} |"
+        )
+    return "\n".join(lines)
