@@ -1,6 +1,7 @@
 """Stubs of the Rust extension `latentrl._native` (hand-written; checked by mypy.stubtest)."""
 
 from collections.abc import Callable, Mapping, Sequence
+from os import PathLike
 from typing import Any, Literal, final
 
 import numpy as np
@@ -16,6 +17,8 @@ __all__ = [
     "arms_fk",
     "arms_ik",
     "gplvm_nll_grad",
+    "humanoid_fall_check",
+    "run_arms_trials",
     "run_bimanual_trials",
 ]
 
@@ -77,6 +80,23 @@ def arms_ik(hands: NDArray[np.float64]) -> NDArray[np.float64]:
     """Postures `(N, 4)` (elbows outward, shoulder angles continuous in front of the body) that
     put the hands at `hands` `(N, 4)`; an unreachable row raises InvalidInputError."""
 
+def humanoid_fall_check(
+    urdf_path: str,
+    start: NDArray[np.float64],
+    targets: NDArray[np.float64],
+    *,
+    hold: float,
+    kp: float,
+    kd: float,
+    max_force: float,
+    dt: float,
+    solver_iterations: int,
+    grip_width: float,
+) -> NDArray[np.float64]:
+    """Fall check of the floating humanoid (SPEC §4.3): stand at `start` (D,), hold each row
+    of `targets` (M, D) for `hold` s; returns (M, 6): fell, min margin, final margin, grip
+    error, max |grip error|, base height."""
+
 def run_bimanual_trials(
     learner: Literal["full", "latent"],
     *,
@@ -90,8 +110,31 @@ def run_bimanual_trials(
     latent_low: ArrayLike | None = None,
     latent_high: ArrayLike | None = None,
     record_episodes: Sequence[int] | None = None,
+    test_episodes: int | None = None,
+    record_test_episodes: Sequence[int] | None = None,
     return_weights: bool = False,
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
     """Runs Experiment 1 (SPEC §4.1) trials in parallel in Rust; see
     `run_bimanual_trials.__doc__` for every argument and the returned arrays."""
+
+def run_arms_trials(
+    urdf: str | PathLike[str],
+    *,
+    decoder: GpMap,
+    encoder: GpMap,
+    latent_low: ArrayLike,
+    latent_high: ArrayLike,
+    n_trials: int,
+    episodes: int,
+    base_seed: int,
+    first_trial: int | None = None,
+    config: Mapping[str, object] | None = None,
+    record_episodes: Sequence[int] | None = None,
+    test_episodes: int | None = None,
+    record_test_episodes: Sequence[int] | None = None,
+    return_weights: bool = False,
+    progress: Callable[[int, int], object] | None = None,
+) -> dict[str, Any]:
+    """Runs Experiment 2 (SPEC §4.2) trials in parallel in Rust on two simulated arms (rapier3d,
+    PD servos) learning in a 2-D latent space; see `run_arms_trials.__doc__`."""

@@ -28,6 +28,11 @@ def _experiments() -> dict[str, tuple[type, Callable[..., Any]]]:
     except ImportError:
         return experiments
     experiments["exp1"] = (Exp1Preset, run_exp1)
+    try:
+        from latentrl.experiments.exp2 import Exp2Preset, run_exp2
+    except ImportError:
+        return experiments
+    experiments["exp2"] = (Exp2Preset, run_exp2)
     return experiments
 
 

@@ -14,7 +14,8 @@
 //! 4. the plant tracks `x̂` for one RL step and reports the reached posture `x̃`, the reward
 //!    (its own penalty included) and whether the episode ended;
 //! 5. encode `z_{t+1} = g(x̃)`;
-//! 6. TD(0) on `(z_t, r_t, z_{t+1})` (Eq. 7–9), terminal if the plant ended the episode.
+//! 6. TD(0) on `(z_t, r_t, z_{t+1})` (Eq. 7–9), terminal if the plant ended the episode
+//!    (skipped in [`Phase::Test`]: frozen test episodes act on the learnt V unchanged).
 //!
 //! The step displacement is `Δ_i = step_fraction · h ⊙ u_i`: each action's unit direction
 //! `u_i` scaled per dimension by the RBF grid spacing `h` (SPEC: 0.2 × spacing).
@@ -97,6 +98,31 @@ pub trait Plant {
     fn reached_target(&self) -> bool {
         false
     }
+
+    /// True if the episode has, since the last reset, passed the plant's waypoint (e.g.
+    /// started below a wall and got above it through a corridor); plants without one keep
+    /// the default `false`.
+    fn passed(&self) -> bool {
+        false
+    }
+
+    /// Checked after an admitted [`Plant::reset`] when the learner is in [`Phase::Test`]:
+    /// whether the current state may also start a frozen test episode (e.g. the hands below
+    /// the wall they must pass). Default: every admissible start.
+    fn admits_test_start(&self) -> bool {
+        true
+    }
+}
+
+/// Whether a learner is training or running frozen test episodes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Phase {
+    /// TD(0) updates after every step (Eq. 7–9).
+    #[default]
+    Train,
+    /// No updates: the soft-max policy acts on the learnt value function as it is, and
+    /// starts must also pass [`Plant::admits_test_start`].
+    Test,
 }
 
 /// The learner's state space relative to the plant's posture space.
@@ -201,6 +227,8 @@ pub struct EpisodeRecord {
     pub steps: usize,
     /// True if [`Plant::reached_target`] held after some plant step.
     pub reached: bool,
+    /// True if [`Plant::passed`] held after some plant step.
+    pub passed: bool,
 }
 
 /// Result of one [`Learner::step`].
@@ -252,6 +280,7 @@ pub struct Learner {
     displacements: Vec<f64>,
     n_actions: usize,
     config: LearnerConfig,
+    phase: Phase,
 }
 
 impl Learner {
@@ -268,7 +297,25 @@ impl Learner {
             .collect();
         let td = TdLearner::new(grid.len(), &config.td)?;
         let policy = SoftmaxPolicy::new(config.beta)?;
-        Ok(Self { grid, td, policy, displacements, n_actions, config: *config })
+        Ok(Self { grid, td, policy, displacements, n_actions, config: *config, phase: Phase::Train })
+    }
+
+    /// Switches between training (TD updates) and frozen test episodes (none).
+    pub fn set_phase(&mut self, phase: Phase) {
+        self.phase = phase;
+    }
+
+    /// The current phase ([`Phase::Train`] when built).
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// TD(0) update (Eq. 7–9) of the features `b`, unless the learner is frozen.
+    #[inline]
+    fn learn(&mut self, b: &SparseFeatures, reward: f64, v_next: Option<f64>) {
+        if self.phase == Phase::Train {
+            self.td.update(b, reward, v_next);
+        }
     }
 
     /// The RBF grid.
@@ -376,6 +423,7 @@ impl Learner {
     }
 
     /// Starts an episode (see [`StartMode`]): resets the plant and sets `z_0` and `b(z_0)`.
+    /// In [`Phase::Test`] a start must also pass [`Plant::admits_test_start`].
     pub fn start<P: Plant, R: Rng + ?Sized>(
         &self,
         plant: &mut P,
@@ -404,9 +452,10 @@ impl Learner {
                     admitted = !gated && plant.reset(&s.reached).is_none();
                 }
             }
-            if admitted {
+            if admitted && (self.phase == Phase::Train || plant.admits_test_start()) {
                 break;
             }
+            admitted = false;
         }
         if !admitted {
             return Err(CoreError::NoValidStart { draws });
@@ -415,7 +464,8 @@ impl Learner {
         Ok(())
     }
 
-    /// One step from the current state (module doc, steps 1–6), TD update included.
+    /// One step from the current state (module doc, steps 1–6), TD update included in
+    /// [`Phase::Train`].
     #[inline]
     pub fn step<P: Plant, R: Rng + ?Sized>(
         &mut self,
@@ -435,26 +485,26 @@ impl Learner {
         shifted(&s.z, &self.displacements[a * dim..(a + 1) * dim], &mut s.candidate);
         let penalty = self.config.penalty;
         if !self.grid.contains(&s.candidate) {
-            self.td.update(&s.current, penalty, None);
+            self.learn(&s.current, penalty, None);
             return StepResult { reward: penalty, end: Some(EndReason::BoxExit), moved: false };
         }
         // 3. Decode (and gate on the variance).
         let var = Self::decode(space, &s.candidate, &mut s.target, s.decode.as_mut());
         if matches!(space, StateSpace::Latent { .. }) && self.config.variance_threshold.is_some_and(|t| var > t) {
-            self.td.update(&s.current, penalty, None);
+            self.learn(&s.current, penalty, None);
             return StepResult { reward: penalty, end: Some(EndReason::Uncertain), moved: false };
         }
         // 4. The plant tracks the target.
         let outcome = plant.step(&s.target, &mut s.reached);
         if let Some(end) = outcome.end {
-            self.td.update(&s.current, outcome.reward, None);
+            self.learn(&s.current, outcome.reward, None);
             return StepResult { reward: outcome.reward, end: Some(end), moved: true };
         }
         // 5. Encode, 6. TD(0) with bootstrap.
         Self::encode(space, &s.reached, &mut s.z_next, s.encode.as_mut());
         self.grid.eval_into(&s.z_next, &mut s.rbf, &mut s.next);
         let v_next = self.td.value(&s.next);
-        self.td.update(&s.current, outcome.reward, Some(v_next));
+        self.learn(&s.current, outcome.reward, Some(v_next));
         std::mem::swap(&mut s.current, &mut s.next);
         std::mem::swap(&mut s.z, &mut s.z_next);
         StepResult { reward: outcome.reward, end: None, moved: true }
@@ -481,7 +531,7 @@ impl Learner {
             }
         };
         record_row(plant, &mut trajectory);
-        let mut record = EpisodeRecord { ret: 0.0, end: EndReason::TimeOut, steps: 0, reached: false };
+        let mut record = EpisodeRecord { ret: 0.0, end: EndReason::TimeOut, steps: 0, reached: false, passed: false };
         while record.steps < self.config.max_steps {
             let r = self.step(plant, space, rng, s);
             record.steps += 1;
@@ -489,6 +539,7 @@ impl Learner {
             if r.moved {
                 record_row(plant, &mut trajectory);
                 record.reached |= plant.reached_target();
+                record.passed |= plant.passed();
             }
             if let Some(end) = r.end {
                 record.end = end;
@@ -545,6 +596,12 @@ mod tests {
         }
         fn task_position(&self, out: &mut [f64]) {
             out[0] = self.x;
+        }
+        fn passed(&self) -> bool {
+            self.x > 0.7
+        }
+        fn admits_test_start(&self) -> bool {
+            self.x < 0.3
         }
     }
 
@@ -619,6 +676,42 @@ mod tests {
         let (last, last_hits) = stats(&records[500..]);
         assert!(last > 1.1 * first, "mean return: first {first}, last {last}");
         assert!(last_hits < first_hits, "obstacle endings: first {first_hits}, last {last_hits}");
+    }
+
+    #[test]
+    fn frozen_learner_keeps_its_weights_and_filters_test_starts() {
+        let config = LearnerConfig {
+            rbf: RbfConfig { centres_per_dim: 11, ..RbfConfig::default() },
+            step_fraction: 1.0,
+            max_steps: 30,
+            start: StartMode::UniformInBox,
+            ..LearnerConfig::default()
+        };
+        let mut l = Learner::new(&config, &[0.0], &[1.0], &orthogonal_actions(1)).unwrap();
+        let mut plant = Corridor { x: 0.0 };
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        let mut s = l.scratch(&StateSpace::Full, 1);
+        let mut starts_above = 0;
+        for _ in 0..300 {
+            let mut traj = Vec::new();
+            l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, Some(&mut traj)).unwrap();
+            starts_above += usize::from(traj[0] >= 0.3);
+        }
+        assert!(starts_above > 0, "training starts are not filtered");
+        let trained = l.weights().to_vec();
+        assert!(trained.iter().any(|&w| w != 0.0));
+        l.set_phase(Phase::Test);
+        assert_eq!(l.phase(), Phase::Test);
+        let mut passes = 0;
+        for _ in 0..40 {
+            let mut traj = Vec::new();
+            let rec = l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, Some(&mut traj)).unwrap();
+            assert!(traj[0] < 0.3, "test start {} not admitted by the plant", traj[0]);
+            assert_eq!(rec.passed, traj[1..].iter().any(|&x| x > 0.7));
+            passes += usize::from(rec.passed);
+        }
+        assert!(passes > 0);
+        assert_eq!(l.weights(), &trained[..], "a frozen learner changed its weights");
     }
 
     #[test]

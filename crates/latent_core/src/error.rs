@@ -59,6 +59,13 @@ pub enum CoreError {
         /// How many starts were drawn.
         draws: usize,
     },
+    /// A plant could not be built for a trial (e.g. a bad robot description); the
+    /// plant's own error, as text.
+    #[error("cannot build the plant: {reason}")]
+    Plant {
+        /// The plant's error message.
+        reason: String,
+    },
 }
 
 /// Result alias for the core.

@@ -14,8 +14,8 @@ pub mod td;
 pub mod trials;
 
 pub use episode::{
-    EndReason, EpisodeRecord, EpisodeScratch, Learner, LearnerConfig, Plant, StartMode, StateSpace, StepOutcome,
-    StepResult,
+    EndReason, EpisodeRecord, EpisodeScratch, Learner, LearnerConfig, Phase, Plant, StartMode, StateSpace,
+    StepOutcome, StepResult,
 };
 pub use error::{CoreError, Result};
 pub use gp::{GpMap, PredictScratch};

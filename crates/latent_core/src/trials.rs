@@ -7,6 +7,11 @@
 //! results are collected in index order, so the output is bitwise the same on 1 or N
 //! threads, and trial `i` gives the same result whether it runs alone or in a sweep
 //! (`first_trial` lets an interrupted sweep resume with the missing indices).
+//!
+//! After its training episodes a trial may run `test_episodes` frozen test episodes
+//! ([`Phase::Test`]: no TD updates, starts filtered by [`crate::Plant::admits_test_start`])
+//! with the same generator, e.g. SPEC §4.2's "50 frozen test episodes from starts below
+//! the wall".
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -14,7 +19,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::episode::{EpisodeRecord, Learner, Plant, StateSpace};
+use crate::episode::{EpisodeRecord, EpisodeScratch, Learner, Phase, Plant, StateSpace};
 use crate::error::{CoreError, Result};
 
 /// The generator of trial `trial`: ChaCha8 seeded from `base_seed`, stream `trial`
@@ -41,6 +46,10 @@ pub struct TrialOptions {
     pub record_episodes: Vec<usize>,
     /// Keep each trial's final value-function weights.
     pub keep_weights: bool,
+    /// Frozen test episodes run after the training episodes ([`Phase::Test`]); 0 = none.
+    pub test_episodes: usize,
+    /// Test-episode indices (0-based) whose task-space trajectory is recorded.
+    pub record_test_episodes: Vec<usize>,
 }
 
 impl Default for TrialOptions {
@@ -52,12 +61,14 @@ impl Default for TrialOptions {
             base_seed: 0,
             record_episodes: Vec::new(),
             keep_weights: false,
+            test_episodes: 0,
+            record_test_episodes: Vec::new(),
         }
     }
 }
 
 impl TrialOptions {
-    /// Checks `n_trials, episodes ≥ 1` and that every recorded episode exists.
+    /// Checks `n_trials, episodes ≥ 1` and that every recorded (test) episode exists.
     pub fn validate(&self) -> Result<()> {
         if self.n_trials == 0 {
             return Err(CoreError::InvalidParameter { name: "n_trials", value: 0.0, reason: "must be at least 1" });
@@ -79,6 +90,13 @@ impl TrialOptions {
                 reason: "every recorded episode index must be < episodes",
             });
         }
+        if let Some(&e) = self.record_test_episodes.iter().find(|&&e| e >= self.test_episodes) {
+            return Err(CoreError::InvalidParameter {
+                name: "record_test_episodes",
+                value: e as f64,
+                reason: "every recorded test episode index must be < test_episodes",
+            });
+        }
         Ok(())
     }
 }
@@ -97,6 +115,10 @@ pub struct TrialResult {
     pub finished: bool,
     /// The final weights, if `keep_weights`.
     pub weights: Option<Vec<f64>>,
+    /// One record per frozen test episode run (empty if cancelled before them).
+    pub tests: Vec<EpisodeRecord>,
+    /// One task-space trajectory per entry of `record_test_episodes`, as `trajectories`.
+    pub test_trajectories: Vec<Vec<f64>>,
 }
 
 /// Runs `options.n_trials` trials in parallel (rayon's current pool). Each trial clones
@@ -104,7 +126,8 @@ pub struct TrialResult {
 /// `make_plant(trial_index)` and runs `options.episodes` episodes in `space`.
 ///
 /// `cancel` is read between episodes: once set, every trial stops and reports
-/// `finished = false`. `done` is incremented after every episode (progress).
+/// `finished = false`. `done` is incremented after every episode, test episodes included
+/// (progress: `n_trials × (episodes + test_episodes)` in all).
 /// Inputs are checked once, up front; the only error past that point is
 /// [`CoreError::NoValidStart`].
 pub fn run_trials<P, F>(
@@ -136,37 +159,62 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
     cancel: &AtomicBool,
     done: &AtomicUsize,
 ) -> Result<TrialResult> {
-    let mut plant = make_plant(trial)?;
-    let mut learner = template.clone();
-    let mut rng = trial_rng(options.base_seed, trial);
-    let mut scratch = learner.scratch(space, plant.posture_dim());
-    let mut episodes = Vec::with_capacity(options.episodes);
-    let mut trajectories = vec![Vec::new(); options.record_episodes.len()];
-    let mut finished = true;
-    let mut buffer = Vec::new();
-    for e in 0..options.episodes {
-        if cancel.load(Ordering::Relaxed) {
-            finished = false;
-            break;
-        }
-        let slot = options.record_episodes.iter().position(|&r| r == e);
-        let record = if slot.is_some() {
-            buffer.clear();
-            learner.run_episode(&mut plant, space, &mut rng, &mut scratch, Some(&mut buffer))?
-        } else {
-            learner.run_episode(&mut plant, space, &mut rng, &mut scratch, None)?
-        };
-        // The same episode may be listed twice: every listed slot gets the trajectory.
-        for (slot, r) in trajectories.iter_mut().zip(&options.record_episodes) {
-            if *r == e {
-                slot.clone_from(&buffer);
-            }
-        }
-        episodes.push(record);
-        done.fetch_add(1, Ordering::Relaxed);
+    let plant = make_plant(trial)?;
+    let learner = template.clone();
+    let scratch = learner.scratch(space, plant.posture_dim());
+    let rng = trial_rng(options.base_seed, trial);
+    let mut run = TrialRun { plant, learner, rng, scratch, space, cancel, done };
+    let (episodes, trajectories, mut finished) = run.block(options.episodes, &options.record_episodes)?;
+    let (mut tests, mut test_trajectories) = (Vec::new(), vec![Vec::new(); options.record_test_episodes.len()]);
+    if finished && options.test_episodes > 0 {
+        run.learner.set_phase(Phase::Test);
+        (tests, test_trajectories, finished) = run.block(options.test_episodes, &options.record_test_episodes)?;
     }
-    let weights = options.keep_weights.then(|| learner.into_weights());
-    Ok(TrialResult { trial, episodes, trajectories, finished, weights })
+    let weights = options.keep_weights.then(|| run.learner.into_weights());
+    Ok(TrialResult { trial, episodes, trajectories, finished, weights, tests, test_trajectories })
+}
+
+/// One trial's plant, learner and generator, run block by block (training, then tests).
+struct TrialRun<'a, P> {
+    plant: P,
+    learner: Learner,
+    rng: ChaCha8Rng,
+    scratch: EpisodeScratch,
+    space: &'a StateSpace<'a>,
+    cancel: &'a AtomicBool,
+    done: &'a AtomicUsize,
+}
+
+impl<P: Plant> TrialRun<'_, P> {
+    /// Runs `n` episodes in the learner's current phase, recording the trajectories of the
+    /// episodes listed in `record`; returns the records, the trajectories and whether the
+    /// block finished (false if cancelled).
+    fn block(&mut self, n: usize, record: &[usize]) -> Result<(Vec<EpisodeRecord>, Vec<Vec<f64>>, bool)> {
+        let mut episodes = Vec::with_capacity(n);
+        let mut trajectories = vec![Vec::new(); record.len()];
+        let mut buffer = Vec::new();
+        for e in 0..n {
+            if self.cancel.load(Ordering::Relaxed) {
+                return Ok((episodes, trajectories, false));
+            }
+            let (plant, rng, space, scratch) = (&mut self.plant, &mut self.rng, self.space, &mut self.scratch);
+            let rec = if record.contains(&e) {
+                buffer.clear();
+                self.learner.run_episode(plant, space, rng, scratch, Some(&mut buffer))?
+            } else {
+                self.learner.run_episode(plant, space, rng, scratch, None)?
+            };
+            // The same episode may be listed twice: every listed slot gets the trajectory.
+            for (slot, r) in trajectories.iter_mut().zip(record) {
+                if *r == e {
+                    slot.clone_from(&buffer);
+                }
+            }
+            episodes.push(rec);
+            self.done.fetch_add(1, Ordering::Relaxed);
+        }
+        Ok((episodes, trajectories, true))
+    }
 }
 
 #[cfg(test)]
@@ -188,5 +236,7 @@ mod tests {
         assert!(TrialOptions { episodes: 0, ..Default::default() }.validate().is_err());
         let o = TrialOptions { episodes: 10, record_episodes: vec![3, 10], ..Default::default() };
         assert!(matches!(o.validate(), Err(CoreError::InvalidParameter { name: "record_episodes", .. })));
+        let o = TrialOptions { test_episodes: 2, record_test_episodes: vec![2], ..Default::default() };
+        assert!(matches!(o.validate(), Err(CoreError::InvalidParameter { name: "record_test_episodes", .. })));
     }
 }

@@ -18,7 +18,8 @@ pub fn to_py(err: CoreError) -> PyErr {
         | CoreError::NonFinite { .. }
         | CoreError::Empty { .. }
         | CoreError::InvalidParameter { .. }
-        | CoreError::NoValidStart { .. } => InvalidInputError::new_err(msg),
+        | CoreError::NoValidStart { .. }
+        | CoreError::Plant { .. } => InvalidInputError::new_err(msg),
         CoreError::NotPositiveDefinite { .. } => NumericalError::new_err(msg),
     }
 }

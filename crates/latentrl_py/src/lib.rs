@@ -1,9 +1,11 @@
 //! `latentrl._native`: the module table. Each file converts one core module; nothing is decided here.
 #![allow(missing_docs)]
 
+mod arms;
 mod convert;
 mod errors;
 mod gp;
+mod humanoid;
 mod rl;
 mod sim;
 
@@ -17,7 +19,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sim::arms_fk, m)?)?;
     m.add_function(wrap_pyfunction!(sim::arms_elbows, m)?)?;
     m.add_function(wrap_pyfunction!(sim::arms_ik, m)?)?;
+    m.add_function(wrap_pyfunction!(humanoid::humanoid_fall_check, m)?)?;
     m.add_function(wrap_pyfunction!(rl::run_bimanual_trials, m)?)?;
+    m.add_function(wrap_pyfunction!(arms::run_arms_trials, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,12 +1,17 @@
-//! Two planar arms on rapier3d 0.36.1: physics steps/s and RL steps/s (SPEC §4.2).
+//! Two planar arms on rapier3d 0.36.1: physics steps/s and RL steps/s (SPEC §4.2), and
+//! the Experiment 2 plant ([`sim::ArmsPlant`]) alone and inside a latent learner's step.
 //!
 //! Peers (PEERS.md): MuJoCo 4.1 µs per step (dt 2 ms), rapier's PyPI wheel 2.4 µs.
 //! Run: `cargo bench -p sim --bench arms_step`.
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use nalgebra::Isometry3;
-use sim::{Obstacle, ObstacleShape, PhysicsSim, SimOptions};
+use latent_core::{GpMap, Plant, SeKernel};
+use nalgebra::{DMatrix, Isometry3};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use sim::arms::{ArmsConfig, ArmsLatent, ArmsPlant, learner_config};
+use sim::{Obstacle, ObstacleShape, PhysicsSim, PlanarArms, SimOptions, UrdfModel};
 
 const TWO_ARMS: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -95,5 +100,72 @@ fn rl_steps(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, physics_steps, rl_steps);
+/// Posture holding the object with the left hand at `(x, y)`.
+fn holding(x: f64, y: f64) -> [f64; 4] {
+    PlanarArms::default().inverse(&[x, y, x + 0.1, y], 0).expect("reachable")
+}
+
+/// One `Plant::step` of the Experiment 2 plant (targets, sub-steps, joints, hands, walls,
+/// reward) at 2 (our default) and 4 solver iterations.
+fn arms_plant_steps(c: &mut Criterion) {
+    let mut group = c.benchmark_group("arms_plant_step");
+    group.throughput(Throughput::Elements(1));
+    let model = UrdfModel::from_file(TWO_ARMS).expect("two_arms.urdf loads");
+    let start = holding(-0.2, 0.2);
+    for iterations in [2, 4] {
+        let config = ArmsConfig {
+            sim: SimOptions { solver_iterations: iterations, ..SimOptions::default() },
+            ..ArmsConfig::default()
+        };
+        let mut plant = ArmsPlant::new(model.clone(), config).expect("plant builds");
+        plant.reset(&start);
+        let targets = [holding(-0.19, 0.2), holding(-0.2, 0.2)];
+        let mut reached = [0.0; 4];
+        let mut k = 0;
+        group.bench_function(BenchmarkId::from_parameter(format!("it{iterations}")), |b| {
+            b.iter(|| {
+                k += 1;
+                black_box(plant.step(&targets[k % 2], &mut reached))
+            })
+        });
+    }
+    group.finish();
+}
+
+/// One full latent RL step (SPEC §3.1: look-ahead over 8 actions, decode, plant, encode,
+/// TD update) on GP maps over a 9 × 9 latent grid of gap-crossing postures.
+fn arms_learner_step(c: &mut Criterion) {
+    let side = 9;
+    let n = side * side;
+    let z = DMatrix::from_fn(2, n, |i, j| (if i == 0 { j % side } else { j / side }) as f64 / (side - 1) as f64);
+    let mut x = DMatrix::zeros(4, n);
+    for j in 0..n {
+        x.column_mut(j).copy_from_slice(&holding(-0.3 + 0.2 * z[(0, j)], 0.12 + 0.33 * z[(1, j)]));
+    }
+    let kernel = SeKernel::new([1.0, 0.1, 1e-6]).expect("valid kernel");
+    let decoder = GpMap::new(z.clone(), x.clone(), kernel).expect("decoder");
+    let encoder = GpMap::new(x, z, kernel).expect("encoder");
+    let latent = ArmsLatent { decoder: &decoder, encoder: &encoder, low: &[0.0, 0.0], high: &[1.0, 1.0] };
+    let config = ArmsConfig { drop_tolerance: 0.02, ..ArmsConfig::default() };
+    let model = UrdfModel::from_file(TWO_ARMS).expect("two_arms.urdf loads");
+    let mut plant = ArmsPlant::new(model, config).expect("plant builds");
+    let (mut learner, space) = latent.build(&learner_config(), 4).expect("learner");
+    let mut scratch = learner.scratch(&space, 4);
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    learner.start(&mut plant, &space, &mut rng, &mut scratch).expect("a start");
+    let mut group = c.benchmark_group("arms_learner_step");
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("latent_8_actions_it2", |b| {
+        b.iter(|| {
+            let r = learner.step(&mut plant, &space, &mut rng, &mut scratch);
+            if r.end.is_some() {
+                learner.start(&mut plant, &space, &mut rng, &mut scratch).expect("a start");
+            }
+            black_box(r)
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, physics_steps, rl_steps, arms_plant_steps, arms_learner_step);
 criterion_main!(benches);

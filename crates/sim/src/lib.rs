@@ -1,14 +1,17 @@
 //! `sim`: the plants latentrl learns to control.
 #![warn(missing_docs)]
 
+pub mod arms;
 pub mod bimanual;
 pub mod error;
+pub mod humanoid;
 pub mod kinematics;
 pub mod obstacles;
 pub mod pd;
 pub mod plant;
 pub mod urdf;
 
+pub use arms::{ArmsConfig, ArmsLatent, ArmsPlant, Wall};
 pub use bimanual::{BimanualConfig, BimanualLearner, BimanualPlant};
 pub use error::SimError;
 pub use kinematics::{ArmsPose, PlanarArms};

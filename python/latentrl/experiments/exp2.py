@@ -68,9 +68,11 @@ class Exp2Preset:
     gplvm_max_iter: int = 1000
     """L-BFGS iteration cap of the GPLVM fit."""
     latent_margin: float = 0.1
-    """Latent box = bounding box of the fitted latent points, widened by this share per side (ours: 10 %)."""
+    """Latent box = bounding box of the fitted latent points, widened by this share per side
+    (ours: 10 %)."""
     drop_tolerance: float = 0.005
-    """Dropped when ‖(h_R − h_L) − (0.1, 0)‖ exceeds this, metres (ours, SPEC §4.2: ≥ 3× the PD tracking error)."""
+    """Dropped when ‖(h_R − h_L) − (0.1, 0)‖ exceeds this, metres (ours, SPEC §4.2: ≥ 3× the
+    PD tracking error)."""
     reward_theta: float = 0.35
     """θ of the reward exp(−θ ‖(h − h*)/ℓ‖²) (paper)."""
     reward_length: float = 0.3
@@ -94,15 +96,18 @@ class Exp2Preset:
     variance_threshold: float = 0.0
     """Latent targets with GPLVM variance above this are infeasible (−1, end); 0 = off (SPEC §3.2)."""
     test_episodes: int = 0
-    """Frozen test episodes per trial after training (no TD updates, hands start below the wall); 0 = none (ours)."""
+    """Frozen test episodes per trial after training (no TD updates, hands start below the
+    wall); 0 = none (ours)."""
     physics_dt: float = 1.0 / 240.0
     """Physics time step, s; δt = physics_dt × substeps = 0.05 s (paper's δt)."""
     substeps: int = 12
     """Physics steps per RL step."""
     solver_iterations: int = 2
-    """rapier solver iterations per physics step (ours: 2 keeps PD tracking < 1 mrad at ~55 % of the cost of 4)."""
+    """rapier solver iterations per physics step (ours: 2 keeps PD tracking < 1 mrad at ~55 %
+    of the cost of 4)."""
     kp: float = 5000.0
-    """PD stiffness of every joint servo, N·m/rad (ours: force-based, tracks a 0.1 rad step to < 1 mrad in 0.05 s)."""
+    """PD stiffness of every joint servo, N·m/rad (ours: force-based, tracks a 0.1 rad step to
+    < 1 mrad in 0.05 s)."""
     kd: float = 50.0
     """PD damping of every joint servo, N·m·s/rad (ours)."""
     curve_window: int = 500
@@ -178,13 +183,17 @@ class Fitted:
     high: NDArray[np.float64]
 
 
-@lru_cache(maxsize=4)
 def fit(preset: Exp2Preset) -> Fitted:
-    """Demonstrations (seeded by `preset.seed`), GPLVM and latent box; cached per preset so
-    `setup` and `figures` share one fit."""
-    demos = arm_postures(preset.n_demos, np.random.default_rng(preset.seed))
-    model = GPLVM(n_components=2, max_iter=preset.gplvm_max_iter, random_state=preset.seed).fit(demos)
-    low, high = latent_box(model.Z_, preset.latent_margin)
+    """Demonstrations (seeded by `preset.seed`), GPLVM and latent box; cached on the fields
+    they depend on, so `setup` and `figures` (and presets that differ elsewhere) share a fit."""
+    return _fit(preset.n_demos, preset.seed, preset.gplvm_max_iter, preset.latent_margin)
+
+
+@lru_cache(maxsize=4)
+def _fit(n_demos: int, seed: int, max_iter: int, margin: float) -> Fitted:
+    demos = arm_postures(n_demos, np.random.default_rng(seed))
+    model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed).fit(demos)
+    low, high = latent_box(model.Z_, margin)
     return Fitted(demos, model, low, high)
 
 
@@ -244,7 +253,10 @@ def in_walls(hands: NDArray[np.float64]) -> NDArray[np.bool_]:
 
 
 def value_function(
-    weights: NDArray[np.float64], low: NDArray[np.float64], high: NDArray[np.float64], points: NDArray[np.float64]
+    weights: NDArray[np.float64],
+    low: NDArray[np.float64],
+    high: NDArray[np.float64],
+    points: NDArray[np.float64],
 ) -> NDArray[np.float64]:
     """V(z) = Σ w_i b_i(z) at `points` (M, 2) with dense normalised RBFs (σ = spacing) on the
     learner's grid, flat index with dimension 0 fastest (as the Rust grid). The learner's
@@ -270,7 +282,8 @@ def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], out: Path) -> 
     save_figure(fig, out, "fig6a")
     weights = arrays.get("latent_weights")
     before = np.full(preset.rbf_per_dim**2, preset.initial_weight)
-    for name, w, when in (("fig6b", before, "before learning"), ("fig6d", weights, "after learning (trial 1)")):
+    panels = (("fig6b", before, "before learning"), ("fig6d", weights, "after learning (trial 1)"))
+    for name, w, when in panels:
         if w is None:
             continue
         fig, ax = plt.subplots(figsize=(6, 5))
@@ -296,8 +309,9 @@ def _walls(ax: Axes) -> None:
 
 
 def _latent_panel(ax: Axes, fitted: Fitted, weights: NDArray[np.float64], grid: int = 120) -> None:
-    """V over the latent box, GPLVM variance shaded (white = low), corridor mapped into latent
-    space (black: decoded hands in a wall), grip broken > 5 mm (red line), target (dashed)."""
+    """V over the latent box, GPLVM variance shaded (darker = higher, log scale), corridor
+    mapped into latent space (black: decoded hands in a wall), grip broken > 5 mm (red line),
+    target region (dashed white), demonstrations' latent points (white dots)."""
     low, high = fitted.low, fitted.high
     g0, g1 = np.meshgrid(np.linspace(low[0], high[0], grid), np.linspace(low[1], high[1], grid))
     points = np.column_stack([g0.ravel(), g1.ravel()])
@@ -308,7 +322,9 @@ def _latent_panel(ax: Axes, fitted: Fitted, weights: NDArray[np.float64], grid: 
     extent = (low[0], high[0], low[1], high[1])
     image = ax.imshow(value, origin="lower", extent=extent, aspect="auto", cmap="viridis")
     plt.colorbar(image, ax=ax, label="V")
-    shade = (variance / max(variance.max(), 1e-12)).reshape(shape)
+    # Log scale: the variance spans orders of magnitude from the demonstrations to the corners.
+    log_var = np.log(np.maximum(variance, 1e-300))
+    shade = ((log_var - log_var.min()) / max(np.ptp(log_var), 1e-12)).reshape(shape)
     overlay = np.zeros((*shape, 4))
     overlay[..., 3] = 0.6 * shade
     ax.imshow(overlay, origin="lower", extent=extent, aspect="auto")

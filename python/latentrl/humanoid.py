@@ -1,0 +1,246 @@
+"""The KHR-1HV-like humanoid (SPEC §4.3): its URDF, a NumPy forward kinematics of the
+whole body, balance (centre of mass, support margin) and grip, and the lift poses.
+
+The kinematics here is independent of rapier: it reads the shipped URDF with
+`xml.etree`, composes the joint origins (URDF rpy R = Rz·Ry·Rx) and places the robot with
+its left sole flat on the ground, as `sim::humanoid::reset_on_ground` does. The physics
+check itself (`fall_check`) runs in Rust.
+
+Frame: x forward, y left, z up; the sagittal plane is x–z. Pitch joints turn about +y, so
+a negative pitch swings a hanging limb forward; knees bend with positive angles.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl import _native
+
+#: Width of the lifted object: the demonstrated hand distance (m).
+GRIP_WIDTH = 0.10
+#: Servo of the humanoid (SPEC §4.3's MuJoCo study): kp N·m/rad, kd N·m·s/rad, cap N·m.
+SERVO = {"kp": 8.0, "kd": 0.1, "max_force": 1.2}
+#: Physics step (s) and solver iterations of the fall check (10 s stand test passes).
+PHYSICS = {"dt": 1.0 / 240.0, "solver_iterations": 4}
+
+
+def urdf_path() -> Path:
+    """Path of the shipped KHR-1HV-like URDF (package data)."""
+    return Path(str(resources.files("latentrl") / "data" / "khr1hv.urdf"))
+
+
+def demos_path(heel: bool = False) -> Path:
+    """Path of the lift demos: centred balance, or the heel-side set of the fall check."""
+    name = "khr1hv_lift_demos_heel.csv" if heel else "khr1hv_lift_demos.csv"
+    return Path(str(resources.files("latentrl") / "data" / name))
+
+
+def _rpy(r: float, p: float, y: float) -> NDArray[np.float64]:
+    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    return rz @ ry @ rx
+
+
+def _axis_angle(axis: NDArray[np.float64], q: float) -> NDArray[np.float64]:
+    a = axis / np.linalg.norm(axis)
+    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(q) * k + (1 - np.cos(q)) * k @ k
+
+
+def _pose(origin: ET.Element | None) -> NDArray[np.float64]:
+    t = np.eye(4)
+    if origin is not None:
+        t[:3, 3] = [float(v) for v in origin.get("xyz", "0 0 0").split()]
+        t[:3, :3] = _rpy(*[float(v) for v in origin.get("rpy", "0 0 0").split()])
+    return t
+
+
+@dataclass(frozen=True)
+class Humanoid:
+    """Kinematic model of a URDF tree: joints, limits, link inertials and sole boxes."""
+
+    joint_names: tuple[str, ...]
+    lower: NDArray[np.float64]
+    upper: NDArray[np.float64]
+    _joints: tuple[tuple[str, str, str, NDArray[np.float64], NDArray[np.float64] | None], ...]
+    _inertials: tuple[tuple[str, float, NDArray[np.float64]], ...]
+    _boxes: dict[str, tuple[NDArray[np.float64], NDArray[np.float64]]]
+    root: str
+
+    @classmethod
+    def from_urdf(cls, path: str | Path | None = None) -> Humanoid:
+        """Reads the URDF at `path` (default: the shipped robot)."""
+        tree = ET.parse(path or urdf_path()).getroot()
+        joints, names, lower, upper = [], [], [], []
+        for j in tree.findall("joint"):
+            parent = j.find("parent").get("link")  # type: ignore[union-attr]
+            child = j.find("child").get("link")  # type: ignore[union-attr]
+            axis = None
+            if j.get("type") != "fixed":
+                axis_el = j.find("axis")
+                xyz = axis_el.get("xyz", "1 0 0") if axis_el is not None else "1 0 0"
+                axis = np.array([float(v) for v in xyz.split()])
+                lim = j.find("limit")
+                names.append(j.get("name"))
+                lower.append(float(lim.get("lower")))  # type: ignore[union-attr]
+                upper.append(float(lim.get("upper")))  # type: ignore[union-attr]
+            joints.append((j.get("name"), parent, child, _pose(j.find("origin")), axis))
+        inertials, boxes = [], {}
+        for link in tree.findall("link"):
+            inertial = link.find("inertial")
+            if inertial is not None:
+                mass = float(inertial.find("mass").get("value"))  # type: ignore[union-attr]
+                centre = _pose(inertial.find("origin"))[:3, 3]
+                inertials.append((link.get("name"), mass, centre))
+            for col in link.findall("collision"):
+                box = col.find("geometry/box")
+                if box is not None:
+                    size = np.array(
+                        [float(v) for v in box.get("size").split()]  # type: ignore[union-attr]
+                    )
+                    boxes[link.get("name")] = (_pose(col.find("origin")), size)
+        children = {j[2] for j in joints}
+        names_of_links = [link.get("name") for link in tree.findall("link")]
+        root = next(n for n in names_of_links if n not in children)
+        return cls(
+            tuple(names), np.array(lower), np.array(upper), tuple(joints), tuple(inertials),
+            boxes, root,
+        )
+
+    def index(self, name: str) -> int:
+        """Column of joint `name` in a posture."""
+        return self.joint_names.index(name)
+
+    def link_poses(
+        self, posture: NDArray[np.float64], base: NDArray[np.float64] | None = None
+    ) -> dict[str, NDArray[np.float64]]:
+        """World 4×4 poses of every link for `posture` (D,) and root pose `base` (4×4)."""
+        q = dict(zip(self.joint_names, np.asarray(posture, dtype=float), strict=True))
+        poses = {self.root: np.eye(4) if base is None else base}
+        pending = list(self._joints)
+        while pending:
+            rest = []
+            for name, parent, child, origin, axis in pending:
+                if parent not in poses:
+                    rest.append((name, parent, child, origin, axis))
+                    continue
+                t = poses[parent] @ origin
+                if axis is not None:
+                    m = np.eye(4)
+                    m[:3, :3] = _axis_angle(axis, q[name])
+                    t = t @ m
+                poses[child] = t
+            pending = rest
+        return poses
+
+    def on_ground(
+        self, posture: NDArray[np.float64], sole: str = "l_foot"
+    ) -> dict[str, NDArray[np.float64]]:
+        """Link poses with `sole` flat on the ground (z = 0), as the Rust reset places it."""
+        poses = self.link_poses(posture)
+        s = poses[sole]
+        yaw = np.arctan2(s[1, 0], s[0, 0])
+        flat = np.eye(4)
+        flat[:3, :3] = _rpy(0.0, 0.0, yaw)
+        flat[:2, 3] = s[:2, 3]
+        base = flat @ np.linalg.inv(s)
+        poses = self.link_poses(posture, base)
+        lowest = min(c[2] for c in self.sole_corners(poses, sole))
+        base[2, 3] -= lowest
+        return self.link_poses(posture, base)
+
+    def sole_corners(
+        self, poses: dict[str, NDArray[np.float64]], sole: str
+    ) -> list[NDArray[np.float64]]:
+        """World corners of the sole box of link `sole`."""
+        origin, size = self._boxes[sole]
+        half = (-0.5, 0.5)
+        signs = np.array([[sx, sy, sz] for sx in half for sy in half for sz in half])
+        return [(poses[sole] @ origin @ np.append(s * size, 1.0))[:3] for s in signs]
+
+    def com(self, poses: dict[str, NDArray[np.float64]]) -> NDArray[np.float64]:
+        """Whole-body centre of mass (3,) from the URDF inertials."""
+        total = sum(m for _, m, _ in self._inertials)
+        return sum(m * (poses[n] @ np.append(c, 1.0))[:3] for n, m, c in self._inertials) / total
+
+    def balance(
+        self, posture: NDArray[np.float64], soles: tuple[str, str] = ("l_foot", "r_foot")
+    ) -> dict[str, float]:
+        """Standing on both soles: support margin (m, CoM projection to the polygon edge,
+        positive inside), CoM distance ahead of the heel edge (m), grip error (m: hand
+        distance − GRIP_WIDTH) and torso pitch (rad, forward positive)."""
+        poses = self.on_ground(posture, soles[0])
+        corners = [c for s in soles for c in self.sole_corners(poses, s)]
+        low = min(c[2] for c in corners)
+        pts = np.array([c[:2] for c in corners if c[2] <= low + 2e-3])
+        com = self.com(poses)[:2]
+        margin = _hull_margin(com, pts)
+        hands = np.linalg.norm(poses["l_hand"][:3, 3] - poses["r_hand"][:3, 3])
+        torso = poses[self.root][:3, :3]
+        return {
+            "margin": margin,
+            "heel": float(com[0] - pts[:, 0].min()),
+            "grip_error": float(hands - GRIP_WIDTH),
+            "torso_pitch": float(np.arctan2(torso[0, 2], torso[2, 2])),
+            "hands_z": float(poses["l_hand"][2, 3]),
+        }
+
+
+def _cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    return float(a[0] * b[1] - a[1] * b[0])
+
+
+def _hull_margin(p: NDArray[np.float64], pts: NDArray[np.float64]) -> float:
+    """Signed distance from `p` to the convex hull of `pts` (positive inside)."""
+    pts = np.unique(np.round(pts, 12), axis=0)
+    pts = pts[np.lexsort((pts[:, 1], pts[:, 0]))]
+
+    def chain(seq: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+        out: list[NDArray[np.float64]] = []
+        for q in seq:
+            while len(out) >= 2 and _cross(out[-1] - out[-2], q - out[-2]) <= 0:
+                out.pop()
+            out.append(q)
+        return out[:-1]
+
+    hull = chain(pts) + chain(pts[::-1])
+    dist, inside = np.inf, True
+    for a, b in zip(hull, hull[1:] + hull[:1], strict=True):
+        e = b - a
+        t = np.clip(np.dot(p - a, e) / np.dot(e, e), 0.0, 1.0)
+        dist = min(dist, float(np.linalg.norm(p - (a + t * e))))
+        inside &= bool(_cross(e, p - a) >= 0)
+    return dist if inside else -dist
+
+
+@lru_cache(maxsize=1)
+def model() -> Humanoid:
+    """The shipped robot's kinematic model (cached)."""
+    return Humanoid.from_urdf()
+
+
+def fall_check(
+    start: NDArray[np.float64],
+    targets: NDArray[np.float64],
+    *,
+    hold: float = 1.0,
+    urdf: str | Path | None = None,
+) -> NDArray[np.float64]:
+    """Physics fall check (Rust): stand at `start`, hold each row of `targets` for `hold` s
+    with the SERVO gains. Returns (M, 6): fell, min margin, final margin, grip error,
+    max |grip error|, base height (see `_native.humanoid_fall_check`)."""
+    start = np.ascontiguousarray(start, dtype=np.float64)
+    targets = np.ascontiguousarray(np.atleast_2d(targets), dtype=np.float64)
+    return _native.humanoid_fall_check(
+        str(urdf or urdf_path()), start, targets, hold=hold, grip_width=GRIP_WIDTH,
+        **SERVO, **PHYSICS,
+    )
