@@ -13,7 +13,7 @@ help: ## list the targets
 $(VENV)/.deps: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib tqdm pytest pytest-timeout hypothesis
+	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib tqdm pytest pytest-timeout hypothesis mypy
 	touch $@
 
 $(VENV)/.built: $(VENV)/.deps Cargo.toml Cargo.lock $(shell find crates python -name '*.rs' -o -name '*.toml' -o -name '*.py' 2>/dev/null)
@@ -26,11 +26,11 @@ demo: build ## reproduce Table I and Experiment 1 (Fig. 4) on defaults into resu
 	$(PY) -m latentrl run table1 --out results/table1
 	$(PY) -m latentrl run exp1 --out results/exp1
 
-test: build ## Rust tests (pure crates) and the default pytest run
+test: lint ## clippy, stub check, Rust tests (pure crates) and the default pytest run
 	cargo test --quiet
 	$(PY) -m pytest -q
 
-test-all: build ## everything, slow reproductions included
+test-all: lint ## everything, slow reproductions included
 	cargo test --quiet
 	$(PY) -m pytest -q -m ''
 
@@ -40,9 +40,9 @@ bench: build ## criterion benches, the NumPy loop and GPy comparisons (JSON in b
 	bash benches/setup_bench_env.sh
 	benches/.venv-bench/bin/python benches/bench_gp.py
 
-lint: build ## clippy (warnings are errors) and the native stubs against the module
-	cargo clippy --workspace --all-targets -- -D warnings
-	$(PY) -m pip install --quiet mypy
+lint: build ## rustfmt, clippy (warnings are errors) and the native stubs against the module
+	cargo fmt --all --check
+	cargo clippy --quiet --workspace --all-targets -- -D warnings
 	$(PY) -m mypy.stubtest latentrl._native
 
 clean: ## remove the venv and build outputs

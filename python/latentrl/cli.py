@@ -19,21 +19,16 @@ from latentrl.experiments.results import environment
 
 
 def _experiments() -> dict[str, tuple[type, Callable[..., Any]]]:
-    """Experiment name → (preset class, run function); imported lazily to keep `--help` fast."""
+    """Experiment name → (preset class, run function)."""
+    from latentrl.experiments.exp1 import Exp1Preset, run_exp1
+    from latentrl.experiments.exp2 import Exp2Preset, run_exp2
     from latentrl.experiments.table1 import Table1Preset, run_table1
 
-    experiments: dict[str, tuple[type, Callable[..., Any]]] = {"table1": (Table1Preset, run_table1)}
-    try:
-        from latentrl.experiments.exp1 import Exp1Preset, run_exp1
-    except ImportError:
-        return experiments
-    experiments["exp1"] = (Exp1Preset, run_exp1)
-    try:
-        from latentrl.experiments.exp2 import Exp2Preset, run_exp2
-    except ImportError:
-        return experiments
-    experiments["exp2"] = (Exp2Preset, run_exp2)
-    return experiments
+    return {
+        "table1": (Table1Preset, run_table1),
+        "exp1": (Exp1Preset, run_exp1),
+        "exp2": (Exp2Preset, run_exp2),
+    }
 
 
 def _add_preset_flags(parser: argparse.ArgumentParser, preset_cls: type) -> None:

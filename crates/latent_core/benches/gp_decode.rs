@@ -1,13 +1,15 @@
 //! GP decode (single point and batch) and GPLVM NLL + gradient.
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use latent_core::{nll_grad, GpMap, SeKernel};
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use latent_core::{GpMap, SeKernel, nll_grad};
 use nalgebra::DMatrix;
 use std::hint::black_box;
 
 /// Deterministic pseudo-data: N latent points in [-1, 1]², D outputs.
 fn data(n: usize, d_out: usize) -> (DMatrix<f64>, DMatrix<f64>) {
     let latent = DMatrix::from_fn(2, n, |i, j| (((j * 7919 + i * 104_729) % 1000) as f64 / 500.0) - 1.0);
-    let mut y = DMatrix::from_fn(d_out, n, |i, j| (latent[(0, j)] * (i + 1) as f64).sin() + latent[(1, j)].cos());
+    let mut y = DMatrix::from_fn(d_out, n, |i, j| {
+        (latent[(0, j)] * (i + 1) as f64).sin() + latent[(1, j)].cos()
+    });
     let mean = y.column_mean();
     for mut c in y.column_iter_mut() {
         c -= &mean;

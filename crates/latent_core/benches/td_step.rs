@@ -3,8 +3,8 @@
 //! uses the sparse 20⁴ grid and 12 actions; the latent learner a 20² grid, 4 actions and GP
 //! maps fitted to 50 constraint-satisfying postures. PEERS.md: NumPy 201 µs (latent),
 //! 660–1200 µs (full); target ≈ 20 µs.
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use latent_core::{trial_rng, EpisodeScratch, GpMap, Learner, LearnerConfig, SeKernel, StateSpace};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use latent_core::{EpisodeScratch, GpMap, Learner, LearnerConfig, SeKernel, StateSpace, trial_rng};
 use nalgebra::DMatrix;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -51,8 +51,12 @@ fn bench_learner(c: &mut Criterion, name: &str, learner: BimanualLearner<'_>) {
 fn steps(c: &mut Criterion) {
     bench_learner(c, "full_4d_20^4_12_actions", BimanualLearner::Full);
     let (decoder, encoder) = maps();
-    let latent =
-        BimanualLearner::Latent { decoder: &decoder, encoder: &encoder, low: &[-0.05, -0.05], high: &[1.05, 1.05] };
+    let latent = BimanualLearner::Latent {
+        decoder: &decoder,
+        encoder: &encoder,
+        low: &[-0.05, -0.05],
+        high: &[1.05, 1.05],
+    };
     bench_learner(c, "latent_2d_20^2_4_actions_N50", latent);
 }
 

@@ -23,9 +23,9 @@
 
 use rand::{Rng, RngExt};
 
-use crate::error::{check_finite, check_positive, CoreError, Result};
+use crate::error::{CoreError, Result, check_finite, check_positive};
 use crate::gp::{GpMap, PredictScratch};
-use crate::policy::{check_actions, SoftmaxPolicy};
+use crate::policy::{SoftmaxPolicy, check_actions};
 use crate::rbf::{RbfConfig, RbfGrid, RbfScratch, SparseFeatures};
 use crate::td::{TdConfig, TdLearner};
 
@@ -55,9 +55,16 @@ impl EndReason {
 
     /// The reason for a code, if it is one.
     pub fn from_code(code: u8) -> Option<Self> {
-        [Self::TimeOut, Self::Obstacle, Self::BoxExit, Self::Drop, Self::Fall, Self::Uncertain]
-            .get(code as usize)
-            .copied()
+        [
+            Self::TimeOut,
+            Self::Obstacle,
+            Self::BoxExit,
+            Self::Drop,
+            Self::Fall,
+            Self::Uncertain,
+        ]
+        .get(code as usize)
+        .copied()
     }
 }
 
@@ -203,7 +210,11 @@ impl LearnerConfig {
             check_positive("variance_threshold", t)?;
         }
         if self.max_steps == 0 {
-            return Err(CoreError::InvalidParameter { name: "max_steps", value: 0.0, reason: "must be at least 1" });
+            return Err(CoreError::InvalidParameter {
+                name: "max_steps",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
         }
         if self.max_start_draws == 0 {
             return Err(CoreError::InvalidParameter {
@@ -297,7 +308,15 @@ impl Learner {
             .collect();
         let td = TdLearner::new(grid.len(), &config.td)?;
         let policy = SoftmaxPolicy::new(config.beta)?;
-        Ok(Self { grid, td, policy, displacements, n_actions, config: *config, phase: Phase::Train })
+        Ok(Self {
+            grid,
+            td,
+            policy,
+            displacements,
+            n_actions,
+            config: *config,
+            phase: Phase::Train,
+        })
     }
 
     /// Switches between training (TD updates) and frozen test episodes (none).
@@ -352,7 +371,11 @@ impl Learner {
     pub fn check_space(&self, space: &StateSpace<'_>, posture_dim: usize) -> Result<()> {
         let dim = self.grid.dim();
         let mismatch = |what: &'static str, expected: usize, got: usize| {
-            Err(CoreError::Shape { what, expected: format!("dimension {expected}"), got: format!("dimension {got}") })
+            Err(CoreError::Shape {
+                what,
+                expected: format!("dimension {expected}"),
+                got: format!("dimension {got}"),
+            })
         };
         match space {
             StateSpace::Full if posture_dim != dim => {
@@ -486,19 +509,31 @@ impl Learner {
         let penalty = self.config.penalty;
         if !self.grid.contains(&s.candidate) {
             self.learn(&s.current, penalty, None);
-            return StepResult { reward: penalty, end: Some(EndReason::BoxExit), moved: false };
+            return StepResult {
+                reward: penalty,
+                end: Some(EndReason::BoxExit),
+                moved: false,
+            };
         }
         // 3. Decode (and gate on the variance).
         let var = Self::decode(space, &s.candidate, &mut s.target, s.decode.as_mut());
         if matches!(space, StateSpace::Latent { .. }) && self.config.variance_threshold.is_some_and(|t| var > t) {
             self.learn(&s.current, penalty, None);
-            return StepResult { reward: penalty, end: Some(EndReason::Uncertain), moved: false };
+            return StepResult {
+                reward: penalty,
+                end: Some(EndReason::Uncertain),
+                moved: false,
+            };
         }
         // 4. The plant tracks the target.
         let outcome = plant.step(&s.target, &mut s.reached);
         if let Some(end) = outcome.end {
             self.learn(&s.current, outcome.reward, None);
-            return StepResult { reward: outcome.reward, end: Some(end), moved: true };
+            return StepResult {
+                reward: outcome.reward,
+                end: Some(end),
+                moved: true,
+            };
         }
         // 5. Encode, 6. TD(0) with bootstrap.
         Self::encode(space, &s.reached, &mut s.z_next, s.encode.as_mut());
@@ -507,7 +542,11 @@ impl Learner {
         self.learn(&s.current, outcome.reward, Some(v_next));
         std::mem::swap(&mut s.current, &mut s.next);
         std::mem::swap(&mut s.z, &mut s.z_next);
-        StepResult { reward: outcome.reward, end: None, moved: true }
+        StepResult {
+            reward: outcome.reward,
+            end: None,
+            moved: true,
+        }
     }
 
     /// Runs one episode: [`Self::start`], then [`Self::step`] until a terminal transition
@@ -531,7 +570,13 @@ impl Learner {
             }
         };
         record_row(plant, &mut trajectory);
-        let mut record = EpisodeRecord { ret: 0.0, end: EndReason::TimeOut, steps: 0, reached: false, passed: false };
+        let mut record = EpisodeRecord {
+            ret: 0.0,
+            end: EndReason::TimeOut,
+            steps: 0,
+            reached: false,
+            passed: false,
+        };
         while record.steps < self.config.max_steps {
             let r = self.step(plant, space, rng, s);
             record.steps += 1;
@@ -589,9 +634,15 @@ mod tests {
             self.x = target[0];
             reached[0] = self.x;
             if self.x > 0.85 {
-                StepOutcome { reward: self.x - 1.0, end: Some(EndReason::Obstacle) }
+                StepOutcome {
+                    reward: self.x - 1.0,
+                    end: Some(EndReason::Obstacle),
+                }
             } else {
-                StepOutcome { reward: self.x, end: None }
+                StepOutcome {
+                    reward: self.x,
+                    end: None,
+                }
             }
         }
         fn task_position(&self, out: &mut [f64]) {
@@ -607,7 +658,10 @@ mod tests {
 
     fn learner(max_steps: usize) -> Learner {
         let config = LearnerConfig {
-            rbf: RbfConfig { centres_per_dim: 11, ..RbfConfig::default() },
+            rbf: RbfConfig {
+                centres_per_dim: 11,
+                ..RbfConfig::default()
+            },
             step_fraction: 1.0,
             max_steps,
             ..LearnerConfig::default()
@@ -622,7 +676,9 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(0);
         let mut s = l.scratch(&StateSpace::Full, 1);
         let mut traj = Vec::new();
-        let rec = l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, Some(&mut traj)).unwrap();
+        let rec = l
+            .run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, Some(&mut traj))
+            .unwrap();
         assert!(rec.steps >= 1 && rec.steps <= 50);
         let rows = traj.len();
         // The reward of every plant step is the reached x; penalties come on top.
@@ -655,8 +711,15 @@ mod tests {
         // Optimistic weights (1/(1 − γ)): with positive rewards and w₀ = 0 the first
         // visited states look best and the soft-max never leaves them.
         let config = LearnerConfig {
-            rbf: RbfConfig { centres_per_dim: 11, ..RbfConfig::default() },
-            td: TdConfig { alpha: 0.5, initial_weight: 20.0, ..TdConfig::default() },
+            rbf: RbfConfig {
+                centres_per_dim: 11,
+                ..RbfConfig::default()
+            },
+            td: TdConfig {
+                alpha: 0.5,
+                initial_weight: 20.0,
+                ..TdConfig::default()
+            },
             step_fraction: 0.5,
             max_steps: 60,
             ..LearnerConfig::default()
@@ -665,8 +728,12 @@ mod tests {
         let mut plant = Corridor { x: 0.0 };
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let mut s = l.scratch(&StateSpace::Full, 1);
-        let records: Vec<EpisodeRecord> =
-            (0..600).map(|_| l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, None).unwrap()).collect();
+        let records: Vec<EpisodeRecord> = (0..600)
+            .map(|_| {
+                l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, None)
+                    .unwrap()
+            })
+            .collect();
         let stats = |r: &[EpisodeRecord]| {
             let mean = r.iter().map(|e| e.ret).sum::<f64>() / r.len() as f64;
             let hits = r.iter().filter(|e| e.end == EndReason::Obstacle).count();
@@ -675,13 +742,19 @@ mod tests {
         let (first, first_hits) = stats(&records[..100]);
         let (last, last_hits) = stats(&records[500..]);
         assert!(last > 1.1 * first, "mean return: first {first}, last {last}");
-        assert!(last_hits < first_hits, "obstacle endings: first {first_hits}, last {last_hits}");
+        assert!(
+            last_hits < first_hits,
+            "obstacle endings: first {first_hits}, last {last_hits}"
+        );
     }
 
     #[test]
     fn frozen_learner_keeps_its_weights_and_filters_test_starts() {
         let config = LearnerConfig {
-            rbf: RbfConfig { centres_per_dim: 11, ..RbfConfig::default() },
+            rbf: RbfConfig {
+                centres_per_dim: 11,
+                ..RbfConfig::default()
+            },
             step_fraction: 1.0,
             max_steps: 30,
             start: StartMode::UniformInBox,
@@ -694,7 +767,8 @@ mod tests {
         let mut starts_above = 0;
         for _ in 0..300 {
             let mut traj = Vec::new();
-            l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, Some(&mut traj)).unwrap();
+            l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, Some(&mut traj))
+                .unwrap();
             starts_above += usize::from(traj[0] >= 0.3);
         }
         assert!(starts_above > 0, "training starts are not filtered");
@@ -705,7 +779,9 @@ mod tests {
         let mut passes = 0;
         for _ in 0..40 {
             let mut traj = Vec::new();
-            let rec = l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, Some(&mut traj)).unwrap();
+            let rec = l
+                .run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, Some(&mut traj))
+                .unwrap();
             assert!(traj[0] < 0.3, "test start {} not admitted by the plant", traj[0]);
             assert_eq!(rec.passed, traj[1..].iter().any(|&x| x > 0.7));
             passes += usize::from(rec.passed);
@@ -726,10 +802,19 @@ mod tests {
     fn mismatched_spaces_are_errors() {
         let l = learner(10);
         assert!(l.check_space(&StateSpace::Full, 1).is_ok());
-        assert!(matches!(l.check_space(&StateSpace::Full, 4), Err(CoreError::Shape { .. })));
-        let bad = LearnerConfig { max_steps: 0, ..LearnerConfig::default() };
+        assert!(matches!(
+            l.check_space(&StateSpace::Full, 4),
+            Err(CoreError::Shape { .. })
+        ));
+        let bad = LearnerConfig {
+            max_steps: 0,
+            ..LearnerConfig::default()
+        };
         assert!(Learner::new(&bad, &[0.0], &[1.0], &[1.0, -1.0]).is_err());
-        let bad = LearnerConfig { variance_threshold: Some(-1.0), ..LearnerConfig::default() };
+        let bad = LearnerConfig {
+            variance_threshold: Some(-1.0),
+            ..LearnerConfig::default()
+        };
         assert!(Learner::new(&bad, &[0.0], &[1.0], &[1.0, -1.0]).is_err());
     }
 }

@@ -74,7 +74,11 @@ pub type Result<T> = std::result::Result<T, CoreError>;
 /// Fails with [`CoreError::NonFinite`] at the first NaN or infinity in `values`.
 pub fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
-        Some(index) => Err(CoreError::NonFinite { what, index, value: values[index] }),
+        Some(index) => Err(CoreError::NonFinite {
+            what,
+            index,
+            value: values[index],
+        }),
         None => Ok(()),
     }
 }
@@ -84,6 +88,10 @@ pub fn check_positive(name: &'static str, value: f64) -> Result<()> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(CoreError::InvalidParameter { name, value, reason: "must be finite and > 0" })
+        Err(CoreError::InvalidParameter {
+            name,
+            value,
+            reason: "must be finite and > 0",
+        })
     }
 }

@@ -7,8 +7,8 @@
 use nalgebra::{DMatrix, DVector, DVectorViewMut};
 use rayon::prelude::*;
 
-use crate::error::{check_finite, CoreError, Result};
-use crate::kernel::{factorize, SeKernel};
+use crate::error::{CoreError, Result, check_finite};
+use crate::kernel::{SeKernel, factorize};
 
 /// Predictive mean and variance of a GP fitted to (inputs, outputs), everything that can be
 /// pre-computed done once: the Cholesky factor `L` of `K` and `α = K⁻¹ (Y − mean)`.
@@ -51,7 +51,14 @@ impl GpMap {
         let centred_t = (&outputs - &mean * DMatrix::from_element(1, n, 1.0)).transpose();
         let factor = factorize(kernel.matrix(&inputs))?;
         let alpha_t = factor.cholesky.solve(&centred_t).transpose();
-        Ok(Self { kernel, inputs, alpha_t, lower: factor.cholesky.l(), mean, jitter: factor.jitter })
+        Ok(Self {
+            kernel,
+            inputs,
+            alpha_t,
+            lower: factor.cholesky.l(),
+            mean,
+            jitter: factor.jitter,
+        })
     }
 
     /// Input dimension q.
@@ -86,7 +93,10 @@ impl GpMap {
 
     /// Fresh buffers for [`Self::predict_into`].
     pub fn scratch(&self) -> PredictScratch {
-        PredictScratch { kstar: DVector::zeros(self.len()), solved: DVector::zeros(self.len()) }
+        PredictScratch {
+            kstar: DVector::zeros(self.len()),
+            solved: DVector::zeros(self.len()),
+        }
     }
 
     /// Eq. 4 at one point `x` (length q): writes the mean `k*ᵀ K⁻¹ Y + mean` into `mean_out`
@@ -174,7 +184,10 @@ mod tests {
         let k = gp.kernel.matrix(&gp.inputs);
         let kinv = k.try_inverse().unwrap();
         let x = [0.3, -0.2];
-        let kstar = DVector::from_iterator(gp.len(), gp.inputs.column_iter().map(|c| gp.kernel.se(&x, c.as_slice())));
+        let kstar = DVector::from_iterator(
+            gp.len(),
+            gp.inputs.column_iter().map(|c| gp.kernel.se(&x, c.as_slice())),
+        );
         let mut mean = vec![0.0; 3];
         let var = gp.predict_into(&x, &mut mean, &mut gp.scratch());
         let dense_var = gp.kernel.prior_variance() - (kstar.transpose() * &kinv * &kstar)[0];
@@ -215,7 +228,10 @@ mod tests {
     #[test]
     fn bad_queries_are_errors() {
         let gp = toy();
-        assert!(matches!(gp.predict(&DMatrix::zeros(3, 1)), Err(CoreError::Shape { .. })));
+        assert!(matches!(
+            gp.predict(&DMatrix::zeros(3, 1)),
+            Err(CoreError::Shape { .. })
+        ));
         let nan = DMatrix::from_element(2, 1, f64::NAN);
         assert!(matches!(gp.predict(&nan), Err(CoreError::NonFinite { .. })));
     }

@@ -2,8 +2,8 @@
 
 use nalgebra::DMatrix;
 
-use crate::error::{check_finite, CoreError, Result};
-use crate::kernel::{factorize, SeKernel};
+use crate::error::{CoreError, Result, check_finite};
+use crate::kernel::{SeKernel, factorize};
 
 /// `L(Z, θ)` and its gradient with respect to `Z` and `log θ`.
 #[derive(Debug, Clone)]
@@ -80,7 +80,12 @@ pub fn nll_grad(latent: &DMatrix<f64>, centred: &DMatrix<f64>, log_theta: [f64; 
         grad_log_theta[0] += g[(i, i)] * kernel.variance;
     }
     grad_log_theta[2] = kernel.noise * g.trace();
-    Ok(NllGrad { nll, grad_latent, grad_log_theta, jitter: factor.jitter })
+    Ok(NllGrad {
+        nll,
+        grad_latent,
+        grad_log_theta,
+        jitter: factor.jitter,
+    })
 }
 
 #[cfg(test)]
@@ -90,7 +95,9 @@ mod tests {
     fn problem() -> (DMatrix<f64>, DMatrix<f64>, [f64; 3]) {
         let n = 10;
         let latent = DMatrix::from_fn(2, n, |i, j| ((j * 7 + i * 3) % 11) as f64 / 5.0 - 1.0 + 0.03 * i as f64);
-        let mut data = DMatrix::from_fn(3, n, |i, j| (latent[(0, j)] * (i + 1) as f64).cos() + latent[(1, j)] * i as f64);
+        let mut data = DMatrix::from_fn(3, n, |i, j| {
+            (latent[(0, j)] * (i + 1) as f64).cos() + latent[(1, j)] * i as f64
+        });
         let mean = data.column_mean();
         for mut c in data.column_iter_mut() {
             c -= &mean;
@@ -109,15 +116,23 @@ mod tests {
             minus[idx] -= h;
             let fd = (nll_grad(&plus, &data, lt).unwrap().nll - nll_grad(&minus, &data, lt).unwrap().nll) / (2.0 * h);
             let an = r.grad_latent[idx];
-            assert!((fd - an).abs() < 1e-5 * (1.0 + an.abs()), "z[{idx}]: fd {fd} analytic {an}");
+            assert!(
+                (fd - an).abs() < 1e-5 * (1.0 + an.abs()),
+                "z[{idx}]: fd {fd} analytic {an}"
+            );
         }
         for p in 0..3 {
             let (mut plus, mut minus) = (lt, lt);
             plus[p] += h;
             minus[p] -= h;
-            let fd = (nll_grad(&latent, &data, plus).unwrap().nll - nll_grad(&latent, &data, minus).unwrap().nll) / (2.0 * h);
+            let fd = (nll_grad(&latent, &data, plus).unwrap().nll - nll_grad(&latent, &data, minus).unwrap().nll)
+                / (2.0 * h);
             let an = r.grad_log_theta[p];
-            assert!((fd - an).abs() < 1e-5 * (1.0 + an.abs()), "log theta{}: fd {fd} analytic {an}", p + 1);
+            assert!(
+                (fd - an).abs() < 1e-5 * (1.0 + an.abs()),
+                "log theta{}: fd {fd} analytic {an}",
+                p + 1
+            );
         }
     }
 
@@ -131,7 +146,11 @@ mod tests {
             + 0.5 * (k.clone().try_inverse().unwrap() * &y * y.transpose()).trace()
             + 0.5 * n * d * (2.0 * std::f64::consts::PI).ln();
         let r = nll_grad(&latent, &data, lt).unwrap();
-        assert!((r.nll - dense).abs() < 1e-9 * dense.abs().max(1.0), "{} vs {dense}", r.nll);
+        assert!(
+            (r.nll - dense).abs() < 1e-9 * dense.abs().max(1.0),
+            "{} vs {dense}",
+            r.nll
+        );
     }
 
     #[test]
@@ -139,6 +158,9 @@ mod tests {
         let (latent, data, lt) = problem();
         let short = data.columns(0, 5).into_owned();
         assert!(matches!(nll_grad(&latent, &short, lt), Err(CoreError::Shape { .. })));
-        assert!(matches!(nll_grad(&latent, &data, [0.0, f64::NAN, 0.0]), Err(CoreError::NonFinite { .. })));
+        assert!(matches!(
+            nll_grad(&latent, &data, [0.0, f64::NAN, 0.0]),
+            Err(CoreError::NonFinite { .. })
+        ));
     }
 }

@@ -2,7 +2,7 @@
 
 use nalgebra::{Cholesky, DMatrix, Dyn};
 
-use crate::error::{check_positive, CoreError, Result};
+use crate::error::{CoreError, Result, check_positive};
 
 /// `k(a, b) = θ1 · exp(−‖a − b‖² / (2 θ2)) + θ3 · δ_ab` (paper Eq. 2).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,7 +21,11 @@ impl SeKernel {
         check_positive("theta1 (signal variance)", theta[0])?;
         check_positive("theta2 (squared length-scale)", theta[1])?;
         check_positive("theta3 (noise variance)", theta[2])?;
-        Ok(Self { variance: theta[0], lengthscale_sq: theta[1], noise: theta[2] })
+        Ok(Self {
+            variance: theta[0],
+            lengthscale_sq: theta[1],
+            noise: theta[2],
+        })
     }
 
     /// The parameters as `[θ1, θ2, θ3]`.
@@ -82,7 +86,8 @@ impl Factor {
                 col[k] = xk;
                 if xk != 0.0 {
                     let l_col = l.column(k);
-                    col.rows_mut(k + 1, n - k - 1).axpy(-xk, &l_col.rows(k + 1, n - k - 1), 1.0);
+                    col.rows_mut(k + 1, n - k - 1)
+                        .axpy(-xk, &l_col.rows(k + 1, n - k - 1), 1.0);
                 }
             }
         }
@@ -117,7 +122,10 @@ pub fn factorize(k: DMatrix<f64>) -> Result<Factor> {
         }
         relative *= 10.0;
     }
-    Err(CoreError::NotPositiveDefinite { n, jitter: MAX_RELATIVE_JITTER * scale })
+    Err(CoreError::NotPositiveDefinite {
+        n,
+        jitter: MAX_RELATIVE_JITTER * scale,
+    })
 }
 
 #[cfg(test)]

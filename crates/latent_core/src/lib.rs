@@ -14,14 +14,14 @@ pub mod td;
 pub mod trials;
 
 pub use episode::{
-    EndReason, EpisodeRecord, EpisodeScratch, Learner, LearnerConfig, Phase, Plant, StartMode, StateSpace,
-    StepOutcome, StepResult,
+    EndReason, EpisodeRecord, EpisodeScratch, Learner, LearnerConfig, Phase, Plant, StartMode, StateSpace, StepOutcome,
+    StepResult,
 };
 pub use error::{CoreError, Result};
 pub use gp::{GpMap, PredictScratch};
-pub use gplvm::{nll_grad, NllGrad};
-pub use kernel::{factorize, Factor, SeKernel};
-pub use policy::{orthogonal_actions, SoftmaxPolicy};
+pub use gplvm::{NllGrad, nll_grad};
+pub use kernel::{Factor, SeKernel, factorize};
+pub use policy::{SoftmaxPolicy, orthogonal_actions};
 pub use rbf::{RbfConfig, RbfGrid, SparseFeatures};
 pub use td::{TdConfig, TdLearner};
-pub use trials::{run_trials, trial_rng, TrialOptions, TrialResult};
+pub use trials::{TrialOptions, TrialResult, run_trials, trial_rng};

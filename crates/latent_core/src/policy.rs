@@ -4,7 +4,7 @@
 
 use rand::{Rng, RngExt};
 
-use crate::error::{check_positive, CoreError, Result};
+use crate::error::{CoreError, Result, check_positive};
 
 /// `π(u_i | s) = exp(β Q(s, u_i)) / Σ_j exp(β Q(s, u_j))` (paper Eq. 10).
 #[derive(Debug, Clone, Copy, PartialEq)]

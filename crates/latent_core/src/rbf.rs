@@ -26,7 +26,7 @@
 //! features far outside the box along a coordinate axis direction, and keeps `V(s)`
 //! defined (the value of the nearest boundary centre) wherever the policy looks ahead.
 
-use crate::error::{check_finite, check_positive, CoreError, Result};
+use crate::error::{CoreError, Result, check_finite, check_positive};
 
 /// Largest number of centres a grid may have (`n^dim`): 2²⁶ weights are 512 MiB.
 pub const MAX_CENTRES: usize = 1 << 26;
@@ -45,7 +45,11 @@ pub struct RbfConfig {
 
 impl Default for RbfConfig {
     fn default() -> Self {
-        Self { centres_per_dim: 20, width: 1.0, cutoff: 3.0 }
+        Self {
+            centres_per_dim: 20,
+            width: 1.0,
+            cutoff: 3.0,
+        }
     }
 }
 
@@ -63,7 +67,11 @@ impl SparseFeatures {
     /// `wᵀ b(s)` (paper Eq. 7 with these features).
     #[inline]
     pub fn dot(&self, weights: &[f64]) -> f64 {
-        self.indices.iter().zip(&self.values).map(|(&i, &b)| weights[i] * b).sum()
+        self.indices
+            .iter()
+            .zip(&self.values)
+            .map(|(&i, &b)| weights[i] * b)
+            .sum()
     }
 
     /// Number of retained centres.
@@ -137,13 +145,15 @@ impl RbfGrid {
         }
         check_positive("rbf width (σ / spacing)", config.width)?;
         check_positive("rbf cutoff (in σ)", config.cutoff)?;
-        let len = u32::try_from(dim).ok().and_then(|d| n.checked_pow(d)).filter(|&l| l <= MAX_CENTRES).ok_or(
-            CoreError::InvalidParameter {
+        let len = u32::try_from(dim)
+            .ok()
+            .and_then(|d| n.checked_pow(d))
+            .filter(|&l| l <= MAX_CENTRES)
+            .ok_or(CoreError::InvalidParameter {
                 name: "centres_per_dim ^ dimension",
                 value: (n as f64).powi(dim as i32),
                 reason: "the grid would exceed MAX_CENTRES (2^26) centres",
-            },
-        )?;
+            })?;
         let spacing: Vec<f64> = (0..dim).map(|k| (high[k] - low[k]) / (n - 1) as f64).collect();
         let reach = config.cutoff * config.width;
         let block = (2.0 * reach).floor().min(n as f64) as usize + 1;
@@ -208,12 +218,17 @@ impl RbfGrid {
     /// True if `s` lies in the closed box `[low, high]`.
     #[inline]
     pub fn contains(&self, s: &[f64]) -> bool {
-        s.iter().zip(&self.low).zip(&self.high).all(|((x, lo), hi)| x >= lo && x <= hi)
+        s.iter()
+            .zip(&self.low)
+            .zip(&self.high)
+            .all(|((x, lo), hi)| x >= lo && x <= hi)
     }
 
     /// Coordinates of centre `index`.
     pub fn centre(&self, index: usize) -> Vec<f64> {
-        (0..self.dim()).map(|k| self.low[k] + ((index / self.strides[k]) % self.n) as f64 * self.spacing[k]).collect()
+        (0..self.dim())
+            .map(|k| self.low[k] + ((index / self.strides[k]) % self.n) as f64 * self.spacing[k])
+            .collect()
     }
 
     /// Fresh buffers for the sparse evaluations.
@@ -231,7 +246,10 @@ impl RbfGrid {
     /// Fresh, pre-sized feature storage.
     pub fn features(&self) -> SparseFeatures {
         let cap = self.block.pow(self.dim() as u32).min(self.len);
-        SparseFeatures { indices: Vec::with_capacity(cap), values: Vec::with_capacity(cap) }
+        SparseFeatures {
+            indices: Vec::with_capacity(cap),
+            values: Vec::with_capacity(cap),
+        }
     }
 
     /// Sparse `b(s)` into `out` (paper Sec. III-D, normalised RBFs; see the module doc for
@@ -240,7 +258,11 @@ impl RbfGrid {
         out.indices.clear();
         out.values.clear();
         let mut sink = FeatureSink { out, total: 0.0 };
-        let total = if self.traverse(s, scratch, &mut sink) { sink.total } else { 0.0 };
+        let total = if self.traverse(s, scratch, &mut sink) {
+            sink.total
+        } else {
+            0.0
+        };
         if total > 0.0 {
             let inv = 1.0 / total;
             out.values.iter_mut().for_each(|b| *b *= inv);
@@ -257,7 +279,11 @@ impl RbfGrid {
     #[inline]
     pub fn value(&self, weights: &[f64], s: &[f64], scratch: &mut RbfScratch) -> f64 {
         debug_assert_eq!(weights.len(), self.len);
-        let mut sink = ValueSink { weights, acc: 0.0, total: 0.0 };
+        let mut sink = ValueSink {
+            weights,
+            acc: 0.0,
+            total: 0.0,
+        };
         if self.traverse(s, scratch, &mut sink) && sink.total > 0.0 {
             sink.acc / sink.total
         } else {
@@ -359,7 +385,13 @@ impl RbfGrid {
     #[inline]
     fn row(&self, d2: f64, phi: f64, index: usize, limit: f64, scratch: &RbfScratch, sink: &mut impl Sink) {
         let count = scratch.count[0];
-        sink.row(index + scratch.first[0], limit - d2, &scratch.d2[..count], &scratch.phi[..count], phi);
+        sink.row(
+            index + scratch.first[0],
+            limit - d2,
+            &scratch.d2[..count],
+            &scratch.phi[..count],
+            phi,
+        );
     }
 
     /// The fallback: flat index of the nearest grid centre.
@@ -444,7 +476,11 @@ mod tests {
     /// `[-0.5, 1.5]^dim`, drawn in the box widened by `margin` spacings on every side.
     /// Returns the largest per-feature difference seen.
     fn compare(dim: usize, n: usize, cutoff: f64, points: usize, margin: f64) -> f64 {
-        let config = RbfConfig { centres_per_dim: n, cutoff, ..RbfConfig::default() };
+        let config = RbfConfig {
+            centres_per_dim: n,
+            cutoff,
+            ..RbfConfig::default()
+        };
         let grid = RbfGrid::new(&vec![-0.5; dim], &vec![1.5; dim], &config).unwrap();
         let pad = margin * grid.spacing()[0];
         let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -528,8 +564,15 @@ mod tests {
 
     #[test]
     fn far_outside_falls_back_to_the_nearest_centre() {
-        let grid =
-            RbfGrid::new(&[0.0, 0.0], &[1.0, 2.0], &RbfConfig { centres_per_dim: 5, ..Default::default() }).unwrap();
+        let grid = RbfGrid::new(
+            &[0.0, 0.0],
+            &[1.0, 2.0],
+            &RbfConfig {
+                centres_per_dim: 5,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         let mut f = grid.features();
         grid.eval_into(&[10.0, 1.1], &mut grid.scratch(), &mut f);
         // Nearest centre: x clamped to index 4, y = 1.1 / 0.5 → index 2.
@@ -544,10 +587,26 @@ mod tests {
     fn bad_configs_are_errors() {
         let c = RbfConfig::default();
         assert!(matches!(RbfGrid::new(&[], &[], &c), Err(CoreError::Empty { .. })));
-        assert!(matches!(RbfGrid::new(&[0.0], &[0.0], &c), Err(CoreError::InvalidParameter { .. })));
-        assert!(matches!(RbfGrid::new(&[0.0], &[1.0, 2.0], &c), Err(CoreError::Shape { .. })));
+        assert!(matches!(
+            RbfGrid::new(&[0.0], &[0.0], &c),
+            Err(CoreError::InvalidParameter { .. })
+        ));
+        assert!(matches!(
+            RbfGrid::new(&[0.0], &[1.0, 2.0], &c),
+            Err(CoreError::Shape { .. })
+        ));
         assert!(RbfGrid::new(&[0.0], &[f64::NAN], &c).is_err());
-        assert!(RbfGrid::new(&[0.0], &[1.0], &RbfConfig { centres_per_dim: 1, ..c }).is_err());
+        assert!(
+            RbfGrid::new(
+                &[0.0],
+                &[1.0],
+                &RbfConfig {
+                    centres_per_dim: 1,
+                    ..c
+                }
+            )
+            .is_err()
+        );
         assert!(RbfGrid::new(&[0.0], &[1.0], &RbfConfig { cutoff: 0.0, ..c }).is_err());
         assert!(RbfGrid::new(&[0.0; 9], &[1.0; 9], &c).is_err(), "20^9 centres");
     }

@@ -4,7 +4,7 @@
 //! update `w ← w + α δ_t b(s_t)` (Eq. 9). A terminal transition (an episode ended by a
 //! penalty) uses `V(s_{t+1}) = 0`.
 
-use crate::error::{check_finite, check_positive, CoreError, Result};
+use crate::error::{CoreError, Result, check_finite, check_positive};
 use crate::rbf::SparseFeatures;
 
 /// Learning parameters; `Default` is the paper's Experiment 1 (α = 0.9, γ = 0.95, w₀ = 0).
@@ -20,7 +20,11 @@ pub struct TdConfig {
 
 impl Default for TdConfig {
     fn default() -> Self {
-        Self { alpha: 0.9, gamma: 0.95, initial_weight: 0.0 }
+        Self {
+            alpha: 0.9,
+            gamma: 0.95,
+            initial_weight: 0.0,
+        }
     }
 }
 
@@ -52,9 +56,15 @@ impl TdLearner {
     pub fn new(n_features: usize, config: &TdConfig) -> Result<Self> {
         config.validate()?;
         if n_features == 0 {
-            return Err(CoreError::Empty { what: "value-function features" });
+            return Err(CoreError::Empty {
+                what: "value-function features",
+            });
         }
-        Ok(Self { weights: vec![config.initial_weight; n_features], alpha: config.alpha, gamma: config.gamma })
+        Ok(Self {
+            weights: vec![config.initial_weight; n_features],
+            alpha: config.alpha,
+            gamma: config.gamma,
+        })
     }
 
     /// The weights `w`, one per feature.
@@ -102,12 +112,19 @@ mod tests {
     use super::*;
 
     fn features(pairs: &[(usize, f64)]) -> SparseFeatures {
-        SparseFeatures { indices: pairs.iter().map(|p| p.0).collect(), values: pairs.iter().map(|p| p.1).collect() }
+        SparseFeatures {
+            indices: pairs.iter().map(|p| p.0).collect(),
+            values: pairs.iter().map(|p| p.1).collect(),
+        }
     }
 
     #[test]
     fn update_follows_eq_8_and_9() {
-        let cfg = TdConfig { alpha: 0.5, gamma: 0.9, initial_weight: 1.0 };
+        let cfg = TdConfig {
+            alpha: 0.5,
+            gamma: 0.9,
+            initial_weight: 1.0,
+        };
         let mut td = TdLearner::new(4, &cfg).unwrap();
         let b = features(&[(1, 0.25), (2, 0.75)]);
         assert_eq!(td.value(&b), 1.0);
@@ -122,7 +139,14 @@ mod tests {
 
     #[test]
     fn terminal_uses_zero_next_value() {
-        let mut td = TdLearner::new(2, &TdConfig { initial_weight: 0.5, ..TdConfig::default() }).unwrap();
+        let mut td = TdLearner::new(
+            2,
+            &TdConfig {
+                initial_weight: 0.5,
+                ..TdConfig::default()
+            },
+        )
+        .unwrap();
         let b = features(&[(0, 1.0)]);
         let delta = td.update(&b, -1.0, None);
         assert!((delta - (-1.5)).abs() < 1e-15);
@@ -133,7 +157,15 @@ mod tests {
     fn converges_to_the_fixed_point_of_a_chain() {
         // Two states, one-hot features: s0 → s1 (r = 0), s1 → terminal (r = 1).
         // Fixed point: V(s1) = 1, V(s0) = γ.
-        let mut td = TdLearner::new(2, &TdConfig { alpha: 0.3, gamma: 0.9, initial_weight: 0.0 }).unwrap();
+        let mut td = TdLearner::new(
+            2,
+            &TdConfig {
+                alpha: 0.3,
+                gamma: 0.9,
+                initial_weight: 0.0,
+            },
+        )
+        .unwrap();
         let (b0, b1) = (features(&[(0, 1.0)]), features(&[(1, 1.0)]));
         for _ in 0..200 {
             let v1 = td.value(&b1);
@@ -146,9 +178,36 @@ mod tests {
 
     #[test]
     fn rejects_bad_parameters() {
-        assert!(TdLearner::new(3, &TdConfig { alpha: 0.0, ..Default::default() }).is_err());
-        assert!(TdLearner::new(3, &TdConfig { gamma: 1.5, ..Default::default() }).is_err());
-        assert!(TdLearner::new(3, &TdConfig { initial_weight: f64::INFINITY, ..Default::default() }).is_err());
+        assert!(
+            TdLearner::new(
+                3,
+                &TdConfig {
+                    alpha: 0.0,
+                    ..Default::default()
+                }
+            )
+            .is_err()
+        );
+        assert!(
+            TdLearner::new(
+                3,
+                &TdConfig {
+                    gamma: 1.5,
+                    ..Default::default()
+                }
+            )
+            .is_err()
+        );
+        assert!(
+            TdLearner::new(
+                3,
+                &TdConfig {
+                    initial_weight: f64::INFINITY,
+                    ..Default::default()
+                }
+            )
+            .is_err()
+        );
         assert!(TdLearner::new(0, &TdConfig::default()).is_err());
     }
 }

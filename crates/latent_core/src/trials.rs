@@ -71,10 +71,18 @@ impl TrialOptions {
     /// Checks `n_trials, episodes ≥ 1` and that every recorded (test) episode exists.
     pub fn validate(&self) -> Result<()> {
         if self.n_trials == 0 {
-            return Err(CoreError::InvalidParameter { name: "n_trials", value: 0.0, reason: "must be at least 1" });
+            return Err(CoreError::InvalidParameter {
+                name: "n_trials",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
         }
         if self.episodes == 0 {
-            return Err(CoreError::InvalidParameter { name: "episodes", value: 0.0, reason: "must be at least 1" });
+            return Err(CoreError::InvalidParameter {
+                name: "episodes",
+                value: 0.0,
+                reason: "must be at least 1",
+            });
         }
         if self.first_trial.checked_add(self.n_trials).is_none() {
             return Err(CoreError::InvalidParameter {
@@ -147,7 +155,10 @@ where
     template.check_space(space, probe.posture_dim())?;
     drop(probe);
     let trials = options.first_trial..options.first_trial + options.n_trials;
-    trials.into_par_iter().map(|trial| run_one(template, space, &make_plant, options, trial, cancel, done)).collect()
+    trials
+        .into_par_iter()
+        .map(|trial| run_one(template, space, &make_plant, options, trial, cancel, done))
+        .collect()
 }
 
 fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
@@ -163,7 +174,15 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
     let learner = template.clone();
     let scratch = learner.scratch(space, plant.posture_dim());
     let rng = trial_rng(options.base_seed, trial);
-    let mut run = TrialRun { plant, learner, rng, scratch, space, cancel, done };
+    let mut run = TrialRun {
+        plant,
+        learner,
+        rng,
+        scratch,
+        space,
+        cancel,
+        done,
+    };
     let (episodes, trajectories, mut finished) = run.block(options.episodes, &options.record_episodes)?;
     let (mut tests, mut test_trajectories) = (Vec::new(), vec![Vec::new(); options.record_test_episodes.len()]);
     if finished && options.test_episodes > 0 {
@@ -171,7 +190,15 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
         (tests, test_trajectories, finished) = run.block(options.test_episodes, &options.record_test_episodes)?;
     }
     let weights = options.keep_weights.then(|| run.learner.into_weights());
-    Ok(TrialResult { trial, episodes, trajectories, finished, weights, tests, test_trajectories })
+    Ok(TrialResult {
+        trial,
+        episodes,
+        trajectories,
+        finished,
+        weights,
+        tests,
+        test_trajectories,
+    })
 }
 
 /// One trial's plant, learner and generator, run block by block (training, then tests).
@@ -200,7 +227,8 @@ impl<P: Plant> TrialRun<'_, P> {
             let (plant, rng, space, scratch) = (&mut self.plant, &mut self.rng, self.space, &mut self.scratch);
             let rec = if record.contains(&e) {
                 buffer.clear();
-                self.learner.run_episode(plant, space, rng, scratch, Some(&mut buffer))?
+                self.learner
+                    .run_episode(plant, space, rng, scratch, Some(&mut buffer))?
             } else {
                 self.learner.run_episode(plant, space, rng, scratch, None)?
             };
@@ -232,11 +260,45 @@ mod tests {
 
     #[test]
     fn options_are_checked() {
-        assert!(TrialOptions { n_trials: 0, ..Default::default() }.validate().is_err());
-        assert!(TrialOptions { episodes: 0, ..Default::default() }.validate().is_err());
-        let o = TrialOptions { episodes: 10, record_episodes: vec![3, 10], ..Default::default() };
-        assert!(matches!(o.validate(), Err(CoreError::InvalidParameter { name: "record_episodes", .. })));
-        let o = TrialOptions { test_episodes: 2, record_test_episodes: vec![2], ..Default::default() };
-        assert!(matches!(o.validate(), Err(CoreError::InvalidParameter { name: "record_test_episodes", .. })));
+        assert!(
+            TrialOptions {
+                n_trials: 0,
+                ..Default::default()
+            }
+            .validate()
+            .is_err()
+        );
+        assert!(
+            TrialOptions {
+                episodes: 0,
+                ..Default::default()
+            }
+            .validate()
+            .is_err()
+        );
+        let o = TrialOptions {
+            episodes: 10,
+            record_episodes: vec![3, 10],
+            ..Default::default()
+        };
+        assert!(matches!(
+            o.validate(),
+            Err(CoreError::InvalidParameter {
+                name: "record_episodes",
+                ..
+            })
+        ));
+        let o = TrialOptions {
+            test_episodes: 2,
+            record_test_episodes: vec![2],
+            ..Default::default()
+        };
+        assert!(matches!(
+            o.validate(),
+            Err(CoreError::InvalidParameter {
+                name: "record_test_episodes",
+                ..
+            })
+        ));
     }
 }

@@ -5,7 +5,7 @@ mod common;
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
 use latent_core::{EndReason, LearnerConfig, TrialOptions, TrialResult};
-use sim::bimanual::{run_bimanual_trials, BimanualConfig, BimanualLearner};
+use sim::bimanual::{BimanualConfig, BimanualLearner, run_bimanual_trials};
 
 fn mean_return(t: &TrialResult, range: std::ops::Range<usize>) -> f64 {
     let n = range.len() as f64;
@@ -15,9 +15,20 @@ fn mean_return(t: &TrialResult, range: std::ops::Range<usize>) -> f64 {
 #[test]
 fn full_space_learner_improves_with_forgiving_tolerance() {
     // SPEC §4.1: at the paper's 0.005 nothing can be learnt; 0.1 (≈ one RBF spacing) can.
-    let plant = BimanualConfig { drop_tolerance: 0.1, ..BimanualConfig::default() };
-    let config = LearnerConfig { max_steps: 200, ..LearnerConfig::default() };
-    let options = TrialOptions { n_trials: 2, episodes: 300, base_seed: 1, ..Default::default() };
+    let plant = BimanualConfig {
+        drop_tolerance: 0.1,
+        ..BimanualConfig::default()
+    };
+    let config = LearnerConfig {
+        max_steps: 200,
+        ..LearnerConfig::default()
+    };
+    let options = TrialOptions {
+        n_trials: 2,
+        episodes: 300,
+        base_seed: 1,
+        ..Default::default()
+    };
     let r = run_bimanual_trials(
         &plant,
         &config,
@@ -44,11 +55,30 @@ fn latent_learner_improves_and_never_drops() {
         low: &common::LATENT_LOW,
         high: &common::LATENT_HIGH,
     };
-    let plant = BimanualConfig { drop_tolerance: 0.005, ..BimanualConfig::default() };
-    let config = LearnerConfig { max_steps: 200, step_fraction: 0.5, ..LearnerConfig::default() };
-    let options = TrialOptions { n_trials: 2, episodes: 300, base_seed: 3, ..Default::default() };
-    let r = run_bimanual_trials(&plant, &config, &learner, &options, &AtomicBool::new(false), &AtomicUsize::new(0))
-        .unwrap();
+    let plant = BimanualConfig {
+        drop_tolerance: 0.005,
+        ..BimanualConfig::default()
+    };
+    let config = LearnerConfig {
+        max_steps: 200,
+        step_fraction: 0.5,
+        ..LearnerConfig::default()
+    };
+    let options = TrialOptions {
+        n_trials: 2,
+        episodes: 300,
+        base_seed: 3,
+        ..Default::default()
+    };
+    let r = run_bimanual_trials(
+        &plant,
+        &config,
+        &learner,
+        &options,
+        &AtomicBool::new(false),
+        &AtomicUsize::new(0),
+    )
+    .unwrap();
     for t in &r {
         assert!(t.episodes.iter().all(|e| e.end != EndReason::Drop));
         let first = mean_return(t, 0..50);

@@ -6,7 +6,7 @@ mod common;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use latent_core::{LearnerConfig, TrialOptions, TrialResult};
-use sim::bimanual::{run_bimanual_trials, BimanualConfig, BimanualLearner};
+use sim::bimanual::{BimanualConfig, BimanualLearner, run_bimanual_trials};
 
 fn options() -> TrialOptions {
     TrialOptions {
@@ -20,7 +20,11 @@ fn options() -> TrialOptions {
 }
 
 fn config() -> LearnerConfig {
-    LearnerConfig { max_steps: 80, step_fraction: 0.5, ..LearnerConfig::default() }
+    LearnerConfig {
+        max_steps: 80,
+        step_fraction: 0.5,
+        ..LearnerConfig::default()
+    }
 }
 
 fn run_on(threads: usize, learner: &BimanualLearner<'_>, options: &TrialOptions) -> Vec<TrialResult> {
@@ -28,7 +32,14 @@ fn run_on(threads: usize, learner: &BimanualLearner<'_>, options: &TrialOptions)
     let done = AtomicUsize::new(0);
     let results = pool
         .install(|| {
-            run_bimanual_trials(&BimanualConfig::default(), &config(), learner, options, &AtomicBool::new(false), &done)
+            run_bimanual_trials(
+                &BimanualConfig::default(),
+                &config(),
+                learner,
+                options,
+                &AtomicBool::new(false),
+                &done,
+            )
         })
         .unwrap();
     assert_eq!(done.load(Ordering::Relaxed), options.n_trials * options.episodes);
@@ -75,13 +86,21 @@ fn latent_one_vs_two_threads() {
     let a = run_on(1, &learner, &options());
     let b = run_on(2, &learner, &options());
     assert_bitwise_equal(&a, &b);
-    assert!(a.iter().flat_map(|t| &t.episodes).all(|e| e.end != latent_core::EndReason::Drop));
+    assert!(
+        a.iter()
+            .flat_map(|t| &t.episodes)
+            .all(|e| e.end != latent_core::EndReason::Drop)
+    );
 }
 
 #[test]
 fn a_trial_is_the_same_alone_or_in_a_sweep() {
     let all = run_on(2, &BimanualLearner::Full, &options());
-    let third = TrialOptions { n_trials: 1, first_trial: 2, ..options() };
+    let third = TrialOptions {
+        n_trials: 1,
+        first_trial: 2,
+        ..options()
+    };
     let alone = run_on(1, &BimanualLearner::Full, &third);
     assert_bitwise_equal(&all[2..3], &alone);
 }
@@ -90,9 +109,15 @@ fn a_trial_is_the_same_alone_or_in_a_sweep() {
 fn cancel_stops_every_trial_unfinished() {
     let cancel = AtomicBool::new(true);
     let done = AtomicUsize::new(0);
-    let r =
-        run_bimanual_trials(&BimanualConfig::default(), &config(), &BimanualLearner::Full, &options(), &cancel, &done)
-            .unwrap();
+    let r = run_bimanual_trials(
+        &BimanualConfig::default(),
+        &config(),
+        &BimanualLearner::Full,
+        &options(),
+        &cancel,
+        &done,
+    )
+    .unwrap();
     assert!(r.iter().all(|t| !t.finished && t.episodes.is_empty()));
     assert_eq!(done.load(Ordering::Relaxed), 0);
 }

@@ -7,7 +7,7 @@ mod common;
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
 use latent_core::{LearnerConfig, TrialOptions, TrialResult};
-use sim::bimanual::{run_bimanual_trials, BimanualConfig, BimanualLearner};
+use sim::bimanual::{BimanualConfig, BimanualLearner, run_bimanual_trials};
 
 fn run(options: &TrialOptions, cancel: bool) -> Vec<TrialResult> {
     let (decoder, encoder) = common::synthetic_maps();
@@ -17,20 +17,44 @@ fn run(options: &TrialOptions, cancel: bool) -> Vec<TrialResult> {
         low: &common::LATENT_LOW,
         high: &common::LATENT_HIGH,
     };
-    let config = LearnerConfig { max_steps: 60, step_fraction: 0.5, ..LearnerConfig::default() };
+    let config = LearnerConfig {
+        max_steps: 60,
+        step_fraction: 0.5,
+        ..LearnerConfig::default()
+    };
     let done = AtomicUsize::new(0);
-    let r = run_bimanual_trials(&BimanualConfig::default(), &config, &learner, options, &AtomicBool::new(cancel), &done)
-        .unwrap();
+    let r = run_bimanual_trials(
+        &BimanualConfig::default(),
+        &config,
+        &learner,
+        options,
+        &AtomicBool::new(cancel),
+        &done,
+    )
+    .unwrap();
     if !cancel {
-        assert_eq!(done.into_inner(), options.n_trials * (options.episodes + options.test_episodes));
+        assert_eq!(
+            done.into_inner(),
+            options.n_trials * (options.episodes + options.test_episodes)
+        );
     }
     r
 }
 
 #[test]
 fn test_episodes_follow_training_without_changing_it() {
-    let base = TrialOptions { n_trials: 2, episodes: 30, base_seed: 7, keep_weights: true, ..Default::default() };
-    let with_tests = TrialOptions { test_episodes: 5, record_test_episodes: vec![4, 0], ..base.clone() };
+    let base = TrialOptions {
+        n_trials: 2,
+        episodes: 30,
+        base_seed: 7,
+        keep_weights: true,
+        ..Default::default()
+    };
+    let with_tests = TrialOptions {
+        test_episodes: 5,
+        record_test_episodes: vec![4, 0],
+        ..base.clone()
+    };
     let plain = run(&base, false);
     let tested = run(&with_tests, false);
     for (p, t) in plain.iter().zip(&tested) {
@@ -44,12 +68,20 @@ fn test_episodes_follow_training_without_changing_it() {
             assert!(rows >= 1 && rows <= t.tests[e].steps + 1);
         }
     }
-    assert_ne!(tested[0].tests, tested[1].tests, "each trial tests with its own generator");
+    assert_ne!(
+        tested[0].tests, tested[1].tests,
+        "each trial tests with its own generator"
+    );
 }
 
 #[test]
 fn a_cancelled_trial_runs_no_test_episodes() {
-    let options = TrialOptions { n_trials: 1, episodes: 10, test_episodes: 5, ..Default::default() };
+    let options = TrialOptions {
+        n_trials: 1,
+        episodes: 10,
+        test_episodes: 5,
+        ..Default::default()
+    };
     let r = run(&options, true);
     assert!(!r[0].finished && r[0].episodes.is_empty() && r[0].tests.is_empty());
 }

@@ -4,16 +4,16 @@
 
 use std::path::PathBuf;
 
-use ::sim::arms::{learner_config, run_arms_trials as run_core, ArmsConfig, ArmsLatent, ArmsPlant, Wall};
 use ::sim::UrdfModel;
+use ::sim::arms::{ArmsConfig, ArmsLatent, ArmsPlant, Wall, learner_config, run_arms_trials as run_core};
 use latent_core::{LearnerConfig, Plant};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::errors::{sim_to_py, to_py};
 use crate::rl::{
-    apply_config_dict, echo_learner, float, floats, gp_map, int_in, invalid, latent_args, pack_results,
-    run_with_polling, type_name, RunArgs,
+    RunArgs, apply_config_dict, echo_learner, float, floats, gp_map, int_in, invalid, latent_args, pack_results,
+    run_with_polling, type_name,
 };
 
 /// The plant keys of Experiment 2's config dict, in the order they are documented and echoed.
@@ -37,7 +37,9 @@ const ARMS_KEYS: [&str; 16] = [
 ];
 
 fn string(name: &str, value: &Bound<'_, PyAny>) -> PyResult<String> {
-    value.extract().map_err(|_| invalid(format!("config[{name:?}]: expected a str, got {}", type_name(value))))
+    value
+        .extract()
+        .map_err(|_| invalid(format!("config[{name:?}]: expected a str, got {}", type_name(value))))
 }
 
 fn walls(value: &Bound<'_, PyAny>) -> PyResult<Vec<Wall>> {
@@ -51,7 +53,12 @@ fn walls(value: &Bound<'_, PyAny>) -> PyResult<Vec<Wall>> {
         })?
         .collect::<PyResult<_>>()?;
     rows.iter()
-        .map(|row| floats::<4>("walls[i]", row).map(|[x0, y0, x1, y1]| Wall { low: [x0, y0], high: [x1, y1] }))
+        .map(|row| {
+            floats::<4>("walls[i]", row).map(|[x0, y0, x1, y1]| Wall {
+                low: [x0, y0],
+                high: [x1, y1],
+            })
+        })
         .collect()
 }
 
@@ -96,7 +103,11 @@ fn echo_config<'py>(py: Python<'py>, plant: &ArmsConfig, learner: &LearnerConfig
     d.set_item("target", plant.target.to_vec())?;
     d.set_item("theta", plant.theta)?;
     d.set_item("length_scale", plant.length_scale)?;
-    let walls: Vec<[f64; 4]> = plant.walls.iter().map(|w| [w.low[0], w.low[1], w.high[0], w.high[1]]).collect();
+    let walls: Vec<[f64; 4]> = plant
+        .walls
+        .iter()
+        .map(|w| [w.low[0], w.low[1], w.high[0], w.high[1]])
+        .collect();
     d.set_item("walls", walls)?;
     d.set_item("grip", plant.grip.to_vec())?;
     d.set_item("drop_tolerance", plant.drop_tolerance)?;
@@ -195,7 +206,12 @@ pub fn run_arms_trials<'py>(
     // Builds one plant and the learner before any thread starts: bad links, limits or
     // dimensions fail here with the plant's own message.
     let probe = ArmsPlant::new(model.clone(), plant.clone()).map_err(sim_to_py)?;
-    let arms_latent = ArmsLatent { decoder: latent.decoder, encoder: latent.encoder, low: &latent.low, high: &latent.high };
+    let arms_latent = ArmsLatent {
+        decoder: latent.decoder,
+        encoder: latent.encoder,
+        low: &latent.low,
+        high: &latent.high,
+    };
     let (template, _) = arms_latent.build(&learner_config, probe.posture_dim()).map_err(to_py)?;
     drop(probe);
     let options = &run.options;

@@ -23,9 +23,9 @@ pub fn points(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<DMatrix
 /// A 1-D array of exactly `len` values.
 pub fn fixed<const LEN: usize>(name: &str, array: &PyReadonlyArray1<'_, f64>) -> PyResult<[f64; LEN]> {
     let values: Vec<f64> = array.as_array().iter().copied().collect();
-    values
-        .try_into()
-        .map_err(|v: Vec<f64>| InvalidInputError::new_err(format!("{name}: expected shape ({LEN},), got ({},)", v.len())))
+    values.try_into().map_err(|v: Vec<f64>| {
+        InvalidInputError::new_err(format!("{name}: expected shape ({LEN},), got ({},)", v.len()))
+    })
 }
 
 /// q×N matrix → `(N, q)` array, without copying the buffer.

@@ -1,14 +1,29 @@
 //! Python exception classes and the single mapping from core errors to them.
 
-use latent_core::CoreError;
 use ::sim::SimError;
+use latent_core::CoreError;
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-create_exception!(latentrl._native, LatentrlError, PyValueError, "Base class of latentrl's errors (a ValueError).");
-create_exception!(latentrl._native, InvalidInputError, LatentrlError, "An argument had the wrong shape, a non-finite value or an impossible value.");
-create_exception!(latentrl._native, NumericalError, LatentrlError, "A computation could not be carried out stably (e.g. a kernel matrix not positive definite).");
+create_exception!(
+    latentrl._native,
+    LatentrlError,
+    PyValueError,
+    "Base class of latentrl's errors (a ValueError)."
+);
+create_exception!(
+    latentrl._native,
+    InvalidInputError,
+    LatentrlError,
+    "An argument had the wrong shape, a non-finite value or an impossible value."
+);
+create_exception!(
+    latentrl._native,
+    NumericalError,
+    LatentrlError,
+    "A computation could not be carried out stably (e.g. a kernel matrix not positive definite)."
+);
 
 /// Converts a core error into its Python exception; the message says what and where.
 pub fn to_py(err: CoreError) -> PyErr {

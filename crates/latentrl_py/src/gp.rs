@@ -1,11 +1,17 @@
 //! Binding of `latent_core::gp` and `latent_core::gplvm`.
 
-use latent_core::{nll_grad, GpMap, SeKernel};
+use latent_core::{GpMap, SeKernel, nll_grad};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{fixed, points, to_points, to_vector};
-use crate::errors::{to_py, InvalidInputError};
+use crate::errors::{InvalidInputError, to_py};
+
+/// Means (M, p) and variances (M,) as NumPy arrays.
+type MeansVariances<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// (nll, ∂nll/∂latent (N, d), ∂nll/∂log θ (3,), jitter).
+type NllGradient<'py> = (f64, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, f64);
 
 /// A fitted GP map (paper Eq. 4): predictive mean and variance from inputs to outputs.
 #[pyclass(name = "GpMap", module = "latentrl._native", frozen)]
@@ -32,25 +38,29 @@ impl PyGpMap {
     }
 
     /// Means (M, p) and variances (M,) at `queries` (M, q).
-    fn predict<'py>(
-        &self,
-        py: Python<'py>,
-        queries: PyReadonlyArray2<'py, f64>,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>)> {
+    fn predict<'py>(&self, py: Python<'py>, queries: PyReadonlyArray2<'py, f64>) -> PyResult<MeansVariances<'py>> {
         let queries = points("queries", &queries)?;
         let (means, variances) = py.detach(|| self.inner.predict(&queries)).map_err(to_py)?;
         Ok((to_points(py, means)?, to_vector(py, variances)))
     }
 
     /// Means only (M, p) at `queries` (M, q): no variance, several times faster.
-    fn predict_mean<'py>(&self, py: Python<'py>, queries: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    fn predict_mean<'py>(
+        &self,
+        py: Python<'py>,
+        queries: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let queries = points("queries", &queries)?;
         let means = py.detach(|| self.inner.predict_mean(&queries)).map_err(to_py)?;
         to_points(py, means)
     }
 
     /// Mean (p,) and variance at one point `x` (q,).
-    fn predict_one<'py>(&self, py: Python<'py>, x: PyReadonlyArray1<'py, f64>) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
+    fn predict_one<'py>(
+        &self,
+        py: Python<'py>,
+        x: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
         let x: Vec<f64> = x.as_array().iter().copied().collect();
         if x.len() != self.inner.input_dim() {
             return Err(InvalidInputError::new_err(format!(
@@ -98,10 +108,15 @@ pub fn gplvm_nll_grad<'py>(
     latent: PyReadonlyArray2<'py, f64>,
     data: PyReadonlyArray2<'py, f64>,
     log_theta: PyReadonlyArray1<'py, f64>,
-) -> PyResult<(f64, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, f64)> {
+) -> PyResult<NllGradient<'py>> {
     let latent = points("latent", &latent)?;
     let data = points("data", &data)?;
     let log_theta = fixed::<3>("log_theta", &log_theta)?;
     let r = py.detach(|| nll_grad(&latent, &data, log_theta)).map_err(to_py)?;
-    Ok((r.nll, to_points(py, r.grad_latent)?, PyArray1::from_vec(py, r.grad_log_theta.to_vec()), r.jitter))
+    Ok((
+        r.nll,
+        to_points(py, r.grad_latent)?,
+        PyArray1::from_vec(py, r.grad_log_theta.to_vec()),
+        r.jitter,
+    ))
 }

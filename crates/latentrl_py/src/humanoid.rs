@@ -1,13 +1,13 @@
 //! Binding of `sim::humanoid`: the fall check of the floating humanoid in one call.
 
-use ::sim::humanoid::{run_fall_check, FallCheckConfig};
+use ::sim::humanoid::{FallCheckConfig, run_fall_check};
 use ::sim::{PdGains, PhysicsSim, RootMode, SimOptions};
 use nalgebra::DMatrix;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{points, to_points};
-use crate::errors::{sim_to_py, InvalidInputError};
+use crate::errors::{InvalidInputError, sim_to_py};
 
 /// Columns of the returned table, one row per target.
 const COLUMNS: usize = 6;
@@ -55,7 +55,11 @@ pub fn humanoid_fall_check<'py>(
         solver_iterations,
         ..SimOptions::default()
     };
-    let config = FallCheckConfig { hold, grip_width, ..FallCheckConfig::default() };
+    let config = FallCheckConfig {
+        hold,
+        grip_width,
+        ..FallCheckConfig::default()
+    };
     let path = urdf_path.to_string();
     let reports = py
         .detach(|| {

@@ -6,14 +6,14 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-use ::sim::bimanual::{run_bimanual_trials as run_core, BimanualConfig, BimanualLearner};
+use ::sim::bimanual::{BimanualConfig, BimanualLearner, run_bimanual_trials as run_core};
 use latent_core::{EpisodeRecord, GpMap, Learner, LearnerConfig, StartMode, TrialOptions, TrialResult};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{to_py, InvalidInputError};
+use crate::errors::{InvalidInputError, to_py};
 use crate::gp::PyGpMap;
 
 /// How often the calling thread wakes to check Ctrl-C and report progress.
@@ -25,7 +25,9 @@ pub(crate) fn invalid(msg: String) -> PyErr {
 
 /// A Python int in `[min, max]`.
 pub(crate) fn int_in(name: &str, value: &Bound<'_, PyAny>, min: i128, max: i128) -> PyResult<i128> {
-    let v: i128 = value.extract().map_err(|_| invalid(format!("{name}: expected an int, got {}", type_name(value))))?;
+    let v: i128 = value
+        .extract()
+        .map_err(|_| invalid(format!("{name}: expected an int, got {}", type_name(value))))?;
     if v < min || v > max {
         return Err(invalid(format!("{name} must lie in [{min}, {max}], got {v}")));
     }
@@ -33,7 +35,11 @@ pub(crate) fn int_in(name: &str, value: &Bound<'_, PyAny>, min: i128, max: i128)
 }
 
 pub(crate) fn type_name(value: &Bound<'_, PyAny>) -> String {
-    value.get_type().name().map(|n| n.to_string()).unwrap_or_else(|_| "?".into())
+    value
+        .get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".into())
 }
 
 pub(crate) fn float(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
@@ -48,7 +54,10 @@ pub(crate) fn float(name: &str, value: &Bound<'_, PyAny>) -> PyResult<f64> {
 
 pub(crate) fn floats<const N: usize>(name: &str, value: &Bound<'_, PyAny>) -> PyResult<[f64; N]> {
     let v: Vec<f64> = value.extract().map_err(|_| {
-        invalid(format!("config[{name:?}]: expected a sequence of {N} numbers, got {}", type_name(value)))
+        invalid(format!(
+            "config[{name:?}]: expected a sequence of {N} numbers, got {}",
+            type_name(value)
+        ))
     })?;
     let arr: [f64; N] = v
         .try_into()
@@ -91,13 +100,16 @@ pub(crate) fn set_learner_key(learner: &mut LearnerConfig, key: &str, v: &Bound<
         "rbf_cutoff" => learner.rbf.cutoff = float(key, v)?,
         "variance_threshold" => learner.variance_threshold = if v.is_none() { None } else { Some(float(key, v)?) },
         "start" => {
-            let s: String =
-                v.extract().map_err(|_| invalid("config[\"start\"]: expected \"plant\" or \"uniform\"".into()))?;
+            let s: String = v
+                .extract()
+                .map_err(|_| invalid("config[\"start\"]: expected \"plant\" or \"uniform\"".into()))?;
             learner.start = match s.as_str() {
                 "plant" => StartMode::FromPlant,
                 "uniform" => StartMode::UniformInBox,
                 other => {
-                    return Err(invalid(format!("config[\"start\"]: expected \"plant\" or \"uniform\", got {other:?}")))
+                    return Err(invalid(format!(
+                        "config[\"start\"]: expected \"plant\" or \"uniform\", got {other:?}"
+                    )));
                 }
             }
         }
@@ -121,7 +133,14 @@ pub(crate) fn echo_learner(d: &Bound<'_, PyDict>, learner: &LearnerConfig) -> Py
     d.set_item("rbf_width", learner.rbf.width)?;
     d.set_item("rbf_cutoff", learner.rbf.cutoff)?;
     d.set_item("variance_threshold", learner.variance_threshold)?;
-    d.set_item("start", if learner.start == StartMode::FromPlant { "plant" } else { "uniform" })?;
+    d.set_item(
+        "start",
+        if learner.start == StartMode::FromPlant {
+            "plant"
+        } else {
+            "uniform"
+        },
+    )?;
     d.set_item("max_start_draws", learner.max_start_draws)?;
     Ok(())
 }
@@ -138,11 +157,15 @@ pub(crate) fn apply_config_dict(
         return Ok(());
     };
     for (key, value) in config.iter() {
-        let key: String =
-            key.extract().map_err(|_| invalid(format!("config: keys must be strings, got {}", type_name(&key))))?;
+        let key: String = key
+            .extract()
+            .map_err(|_| invalid(format!("config: keys must be strings, got {}", type_name(&key))))?;
         if !set_plant(&key, &value, learner)? && !set_learner_key(learner, &key, &value)? {
             let valid: Vec<&str> = plant_keys.iter().chain(&LEARNER_KEYS).copied().collect();
-            return Err(invalid(format!("config: unknown key {key:?}; valid keys: {}", valid.join(", "))));
+            return Err(invalid(format!(
+                "config: unknown key {key:?}; valid keys: {}",
+                valid.join(", ")
+            )));
         }
     }
     learner.validate().map_err(to_py)
@@ -212,7 +235,10 @@ fn echo_config<'py>(py: Python<'py>, plant: &BimanualConfig, learner: &LearnerCo
     Ok(d)
 }
 
-pub(crate) fn gp_map<'a, 'py>(name: &str, value: &'a Option<Bound<'py, PyAny>>) -> PyResult<Option<&'a Bound<'py, PyGpMap>>> {
+pub(crate) fn gp_map<'a, 'py>(
+    name: &str,
+    value: &'a Option<Bound<'py, PyAny>>,
+) -> PyResult<Option<&'a Bound<'py, PyGpMap>>> {
     match value {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
@@ -224,10 +250,15 @@ pub(crate) fn gp_map<'a, 'py>(name: &str, value: &'a Option<Bound<'py, PyAny>>) 
 }
 
 fn corner(name: &'static str, value: Option<&Bound<'_, PyAny>>, dim: usize, context: &str) -> PyResult<Vec<f64>> {
-    let value = value.filter(|v| !v.is_none()).ok_or_else(|| invalid(format!("{name} is required {context}")))?;
-    let v: Vec<f64> = value
-        .extract()
-        .map_err(|_| invalid(format!("{name}: expected a 1-D array of {dim} numbers, got {}", type_name(value))))?;
+    let value = value
+        .filter(|v| !v.is_none())
+        .ok_or_else(|| invalid(format!("{name} is required {context}")))?;
+    let v: Vec<f64> = value.extract().map_err(|_| {
+        invalid(format!(
+            "{name}: expected a 1-D array of {dim} numbers, got {}",
+            type_name(value)
+        ))
+    })?;
     if v.len() != dim {
         return Err(invalid(format!(
             "{name}: expected shape ({dim},) (the decoder's input dimension), got ({},)",
@@ -270,9 +301,17 @@ pub(crate) fn latent_args<'a, 'py>(
     let low = corner("latent_low", latent_low, dim, context)?;
     let high = corner("latent_high", latent_high, dim, context)?;
     if let Some(k) = (0..dim).find(|&k| high[k] <= low[k]) {
-        return Err(invalid(format!("latent_high[{k}] = {} must exceed latent_low[{k}] = {}", high[k], low[k])));
+        return Err(invalid(format!(
+            "latent_high[{k}] = {} must exceed latent_low[{k}] = {}",
+            high[k], low[k]
+        )));
     }
-    Ok(LatentArgs { decoder, encoder, low, high })
+    Ok(LatentArgs {
+        decoder,
+        encoder,
+        low,
+        high,
+    })
 }
 
 /// The arguments every trial runner takes, as given (checked by [`RunArgs::check`]).
@@ -305,7 +344,9 @@ fn indices(name: &str, value: Option<&Bound<'_, PyAny>>, n: usize) -> PyResult<V
         .try_iter()
         .map_err(|_| invalid(format!("{name}: expected a sequence of ints, got {}", type_name(value))))?
         .collect::<PyResult<_>>()?;
-    list.iter().map(|e| int_in(&format!("{name}[i]"), e, 0, n as i128 - 1).map(|v| v as usize)).collect()
+    list.iter()
+        .map(|e| int_in(&format!("{name}[i]"), e, 0, n as i128 - 1).map(|v| v as usize))
+        .collect()
 }
 
 impl<'py> RunArgs<'_, 'py> {
@@ -323,9 +364,11 @@ impl<'py> RunArgs<'_, 'py> {
             None => 0,
         };
         let config = match self.config.filter(|c| !c.is_none()) {
-            Some(c) => {
-                Some(c.cast::<PyDict>().map_err(|_| invalid(format!("config: expected a dict, got {}", type_name(c))))?.clone())
-            }
+            Some(c) => Some(
+                c.cast::<PyDict>()
+                    .map_err(|_| invalid(format!("config: expected a dict, got {}", type_name(c))))?
+                    .clone(),
+            ),
             None => None,
         };
         let options = TrialOptions {
@@ -343,9 +386,16 @@ impl<'py> RunArgs<'_, 'py> {
         if let Some(p) = &progress
             && !p.is_callable()
         {
-            return Err(invalid(format!("progress: expected a callable or None, got {}", type_name(p))));
+            return Err(invalid(format!(
+                "progress: expected a callable or None, got {}",
+                type_name(p)
+            )));
         }
-        Ok(Checked { options, config, progress })
+        Ok(Checked {
+            options,
+            config,
+            progress,
+        })
     }
 }
 
@@ -414,9 +464,12 @@ pub fn run_bimanual_trials<'py>(
     return_weights: bool,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let name: String = learner
-        .extract()
-        .map_err(|_| invalid(format!("learner: expected \"full\" or \"latent\", got {}", type_name(learner))))?;
+    let name: String = learner.extract().map_err(|_| {
+        invalid(format!(
+            "learner: expected \"full\" or \"latent\", got {}",
+            type_name(learner)
+        ))
+    })?;
     #[rustfmt::skip]
     let run = RunArgs { n_trials, episodes, base_seed, first_trial, config, record_episodes, test_episodes,
                         record_test_episodes, return_weights, progress }.check()?;
@@ -443,7 +496,11 @@ pub fn run_bimanual_trials<'py>(
                 high: &latent.high,
             }
         }
-        other => return Err(invalid(format!("learner: expected \"full\" or \"latent\", got {other:?}"))),
+        other => {
+            return Err(invalid(format!(
+                "learner: expected \"full\" or \"latent\", got {other:?}"
+            )));
+        }
     };
     // Validates the learner (grid size, dimensions) before any thread starts.
     let (template, _) = bimanual.build(&plant, &learner_config).map_err(to_py)?;
@@ -510,8 +567,9 @@ where
         if let Some(e) = failure {
             return Err(e);
         }
-        let results =
-            joined.map_err(|_| PyRuntimeError::new_err("internal error: the trial worker panicked"))?.map_err(to_py)?;
+        let results = joined
+            .map_err(|_| PyRuntimeError::new_err("internal error: the trial worker panicked"))?
+            .map_err(to_py)?;
         if let Some(cb) = progress {
             cb.call1((done.load(Ordering::Relaxed), total))?;
         }
@@ -542,12 +600,23 @@ pub(crate) fn pack_results<'py>(
                 traj[start..start + len].copy_from_slice(&path[..len]);
             }
         }
-        out.set_item(name, PyArray1::from_vec(py, traj).reshape([results.len(), n, rows, task_dim])?)
+        out.set_item(
+            name,
+            PyArray1::from_vec(py, traj).reshape([results.len(), n, rows, task_dim])?,
+        )
     };
     paths("trajectories", options.record_episodes.len(), |r| &r.trajectories)?;
-    paths("test_trajectories", options.record_test_episodes.len(), |r| &r.test_trajectories)?;
-    out.set_item("finished", PyArray1::from_vec(py, results.iter().map(|r| r.finished).collect::<Vec<bool>>()))?;
-    out.set_item("trials", PyArray1::from_vec(py, results.iter().map(|r| r.trial as i64).collect::<Vec<i64>>()))?;
+    paths("test_trajectories", options.record_test_episodes.len(), |r| {
+        &r.test_trajectories
+    })?;
+    out.set_item(
+        "finished",
+        PyArray1::from_vec(py, results.iter().map(|r| r.finished).collect::<Vec<bool>>()),
+    )?;
+    out.set_item(
+        "trials",
+        PyArray1::from_vec(py, results.iter().map(|r| r.trial as i64).collect::<Vec<i64>>()),
+    )?;
     let m = template.grid().len();
     if options.keep_weights {
         let mut w = Vec::with_capacity(results.len() * m);
@@ -591,10 +660,19 @@ fn pack_episodes<'py>(
             passed[k] = rec.passed;
         }
     }
-    out.set_item(format!("{prefix}returns"), PyArray1::from_vec(py, returns).reshape([t, n])?)?;
+    out.set_item(
+        format!("{prefix}returns"),
+        PyArray1::from_vec(py, returns).reshape([t, n])?,
+    )?;
     out.set_item(format!("{prefix}ends"), PyArray1::from_vec(py, ends).reshape([t, n])?)?;
     out.set_item(format!("{prefix}steps"), PyArray1::from_vec(py, steps).reshape([t, n])?)?;
-    out.set_item(format!("{prefix}reached"), PyArray1::from_vec(py, reached).reshape([t, n])?)?;
-    out.set_item(format!("{prefix}passed"), PyArray1::from_vec(py, passed).reshape([t, n])?)?;
+    out.set_item(
+        format!("{prefix}reached"),
+        PyArray1::from_vec(py, reached).reshape([t, n])?,
+    )?;
+    out.set_item(
+        format!("{prefix}passed"),
+        PyArray1::from_vec(py, passed).reshape([t, n])?,
+    )?;
     Ok(())
 }

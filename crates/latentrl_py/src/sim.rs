@@ -1,12 +1,12 @@
 //! Binding of `sim::kinematics`: batch forward and inverse kinematics of the two planar arms.
 
+use ::sim::PlanarArms;
 use nalgebra::DMatrix;
 use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
-use ::sim::PlanarArms;
 
 use crate::convert::{points, to_points};
-use crate::errors::{sim_to_py, InvalidInputError};
+use crate::errors::{InvalidInputError, sim_to_py};
 
 /// `(N, 4)` array → flat row-major values, or InvalidInputError naming `name`.
 fn rows4(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<DMatrix<f64>> {
@@ -27,7 +27,9 @@ fn rows4(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<DMatrix<f64>
 pub fn arms_fk<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let postures = rows4("postures", &postures)?;
     let n = postures.ncols();
-    let hands = py.detach(|| PlanarArms::default().forward_batch(postures.as_slice())).map_err(sim_to_py)?;
+    let hands = py
+        .detach(|| PlanarArms::default().forward_batch(postures.as_slice()))
+        .map_err(sim_to_py)?;
     to_points(py, DMatrix::from_vec(4, n, hands))
 }
 
@@ -36,7 +38,9 @@ pub fn arms_fk<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -> Py
 pub fn arms_elbows<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let postures = rows4("postures", &postures)?;
     let n = postures.ncols();
-    let elbows = py.detach(|| PlanarArms::default().elbows_batch(postures.as_slice())).map_err(sim_to_py)?;
+    let elbows = py
+        .detach(|| PlanarArms::default().elbows_batch(postures.as_slice()))
+        .map_err(sim_to_py)?;
     to_points(py, DMatrix::from_vec(4, n, elbows))
 }
 
@@ -46,6 +50,8 @@ pub fn arms_elbows<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -
 pub fn arms_ik<'py>(py: Python<'py>, hands: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let hands = rows4("hands", &hands)?;
     let n = hands.ncols();
-    let postures = py.detach(|| PlanarArms::default().inverse_batch(hands.as_slice())).map_err(sim_to_py)?;
+    let postures = py
+        .detach(|| PlanarArms::default().inverse_batch(hands.as_slice()))
+        .map_err(sim_to_py)?;
     to_points(py, DMatrix::from_vec(4, n, postures))
 }

@@ -13,10 +13,7 @@ use rand_chacha::ChaCha8Rng;
 use sim::arms::{ArmsConfig, ArmsLatent, ArmsPlant, learner_config};
 use sim::{Obstacle, ObstacleShape, PhysicsSim, PlanarArms, SimOptions, UrdfModel};
 
-const TWO_ARMS: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../python/latentrl/data/two_arms.urdf"
-);
+const TWO_ARMS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/two_arms.urdf");
 const START: [f64; 4] = [0.6, -1.2, 2.5, 1.2];
 
 fn arms(options: SimOptions) -> PhysicsSim {
@@ -102,7 +99,9 @@ fn rl_steps(c: &mut Criterion) {
 
 /// Posture holding the object with the left hand at `(x, y)`.
 fn holding(x: f64, y: f64) -> [f64; 4] {
-    PlanarArms::default().inverse(&[x, y, x + 0.1, y], 0).expect("reachable")
+    PlanarArms::default()
+        .inverse(&[x, y, x + 0.1, y], 0)
+        .expect("reachable")
 }
 
 /// One `Plant::step` of the Experiment 2 plant (targets, sub-steps, joints, hands, walls,
@@ -114,7 +113,10 @@ fn arms_plant_steps(c: &mut Criterion) {
     let start = holding(-0.2, 0.2);
     for iterations in [2, 4] {
         let config = ArmsConfig {
-            sim: SimOptions { solver_iterations: iterations, ..SimOptions::default() },
+            sim: SimOptions {
+                solver_iterations: iterations,
+                ..SimOptions::default()
+            },
             ..ArmsConfig::default()
         };
         let mut plant = ArmsPlant::new(model.clone(), config).expect("plant builds");
@@ -137,29 +139,44 @@ fn arms_plant_steps(c: &mut Criterion) {
 fn arms_learner_step(c: &mut Criterion) {
     let side = 9;
     let n = side * side;
-    let z = DMatrix::from_fn(2, n, |i, j| (if i == 0 { j % side } else { j / side }) as f64 / (side - 1) as f64);
+    let z = DMatrix::from_fn(2, n, |i, j| {
+        (if i == 0 { j % side } else { j / side }) as f64 / (side - 1) as f64
+    });
     let mut x = DMatrix::zeros(4, n);
     for j in 0..n {
-        x.column_mut(j).copy_from_slice(&holding(-0.3 + 0.2 * z[(0, j)], 0.12 + 0.33 * z[(1, j)]));
+        x.column_mut(j)
+            .copy_from_slice(&holding(-0.3 + 0.2 * z[(0, j)], 0.12 + 0.33 * z[(1, j)]));
     }
     let kernel = SeKernel::new([1.0, 0.1, 1e-6]).expect("valid kernel");
     let decoder = GpMap::new(z.clone(), x.clone(), kernel).expect("decoder");
     let encoder = GpMap::new(x, z, kernel).expect("encoder");
-    let latent = ArmsLatent { decoder: &decoder, encoder: &encoder, low: &[0.0, 0.0], high: &[1.0, 1.0] };
-    let config = ArmsConfig { drop_tolerance: 0.02, ..ArmsConfig::default() };
+    let latent = ArmsLatent {
+        decoder: &decoder,
+        encoder: &encoder,
+        low: &[0.0, 0.0],
+        high: &[1.0, 1.0],
+    };
+    let config = ArmsConfig {
+        drop_tolerance: 0.02,
+        ..ArmsConfig::default()
+    };
     let model = UrdfModel::from_file(TWO_ARMS).expect("two_arms.urdf loads");
     let mut plant = ArmsPlant::new(model, config).expect("plant builds");
     let (mut learner, space) = latent.build(&learner_config(), 4).expect("learner");
     let mut scratch = learner.scratch(&space, 4);
     let mut rng = ChaCha8Rng::seed_from_u64(0);
-    learner.start(&mut plant, &space, &mut rng, &mut scratch).expect("a start");
+    learner
+        .start(&mut plant, &space, &mut rng, &mut scratch)
+        .expect("a start");
     let mut group = c.benchmark_group("arms_learner_step");
     group.throughput(Throughput::Elements(1));
     group.bench_function("latent_8_actions_it2", |b| {
         b.iter(|| {
             let r = learner.step(&mut plant, &space, &mut rng, &mut scratch);
             if r.end.is_some() {
-                learner.start(&mut plant, &space, &mut rng, &mut scratch).expect("a start");
+                learner
+                    .start(&mut plant, &space, &mut rng, &mut scratch)
+                    .expect("a start");
             }
             black_box(r)
         })

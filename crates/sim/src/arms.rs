@@ -24,15 +24,15 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
+use latent_core::GpMap;
 use latent_core::episode::{EndReason, Learner, LearnerConfig, Plant, StartMode, StateSpace, StepOutcome};
 use latent_core::error::{CoreError, Result as CoreResult};
 use latent_core::policy::orthogonal_and_diagonal_actions_2d;
-use latent_core::trials::{run_trials, TrialOptions, TrialResult};
 use latent_core::td::TdConfig;
-use latent_core::GpMap;
+use latent_core::trials::{TrialOptions, TrialResult, run_trials};
 use rand::Rng;
 
-use crate::error::{check_finite, Result, SimError};
+use crate::error::{Result, SimError, check_finite};
 use crate::plant::{Frame, PhysicsSim, SimOptions};
 use crate::urdf::UrdfModel;
 
@@ -93,7 +93,16 @@ impl Default for ArmsConfig {
             target: [-0.05, 0.47, 0.05, 0.47],
             theta: 0.35,
             length_scale: 0.3,
-            walls: vec![Wall { low: [-1.0, 0.30], high: [-0.36, 0.37] }, Wall { low: [-0.06, 0.30], high: [1.0, 0.37] }],
+            walls: vec![
+                Wall {
+                    low: [-1.0, 0.30],
+                    high: [-0.36, 0.37],
+                },
+                Wall {
+                    low: [-0.06, 0.30],
+                    high: [1.0, 0.37],
+                },
+            ],
             grip: [0.1, 0.0],
             drop_tolerance: 0.005,
             penalty: -1.0,
@@ -101,8 +110,16 @@ impl Default for ArmsConfig {
             left_hand: "left_hand".to_string(),
             right_hand: "right_hand".to_string(),
             // PlanarArms::default().inverse(&[-0.25, 0.15, -0.15, 0.15]) (tested below).
-            start_posture: [3.424_417_622_960_777_7, -2.531_237_385_236_626_6, 1.700_348_493_943_719_2, 1.955_193_101_290_535_7],
-            sim: SimOptions { solver_iterations: 2, ..SimOptions::default() },
+            start_posture: [
+                3.424_417_622_960_777_7,
+                -2.531_237_385_236_626_6,
+                1.700_348_493_943_719_2,
+                1.955_193_101_290_535_7,
+            ],
+            sim: SimOptions {
+                solver_iterations: 2,
+                ..SimOptions::default()
+            },
         }
     }
 }
@@ -121,7 +138,11 @@ impl ArmsConfig {
             ("reached_rms", self.reached_rms),
         ] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(SimError::InvalidParameter { name, value, reason: "must be finite and > 0" });
+                return Err(SimError::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be finite and > 0",
+                });
             }
         }
         for wall in &self.walls {
@@ -189,10 +210,21 @@ impl ArmsPlant {
     pub fn new(model: UrdfModel, config: ArmsConfig) -> Result<Self> {
         config.validate()?;
         let mut sim = PhysicsSim::new(model, config.sim.clone())?;
-        let frames = [sim.frame(&config.left_hand, [0.0; 3])?, sim.frame(&config.right_hand, [0.0; 3])?];
+        let frames = [
+            sim.frame(&config.left_hand, [0.0; 3])?,
+            sim.frame(&config.right_hand, [0.0; 3])?,
+        ];
         sim.reset(&config.start_posture)?;
         let band = config.wall_band();
-        let mut plant = Self { sim, config, frames, band, hands: [0.0; 4], started_below: false, went_above: false };
+        let mut plant = Self {
+            sim,
+            config,
+            frames,
+            band,
+            hands: [0.0; 4],
+            started_below: false,
+            went_above: false,
+        };
         plant.read_hands();
         Ok(plant)
     }
@@ -252,7 +284,10 @@ impl Plant for ArmsPlant {
         if self.sim.set_targets(target).is_err() {
             // A non-finite target (the learner never sends one): end as a box exit.
             self.sim.joint_positions_into(reached);
-            return StepOutcome { reward: self.config.penalty, end: Some(EndReason::BoxExit) };
+            return StepOutcome {
+                reward: self.config.penalty,
+                end: Some(EndReason::BoxExit),
+            };
         }
         self.sim.step_rl();
         self.sim.joint_positions_into(reached);
@@ -287,7 +322,11 @@ impl Plant for ArmsPlant {
 /// box (redrawn while the plant refuses them).
 pub fn learner_config() -> LearnerConfig {
     LearnerConfig {
-        td: TdConfig { alpha: 0.8, gamma: 0.99, initial_weight: 0.0 },
+        td: TdConfig {
+            alpha: 0.8,
+            gamma: 0.99,
+            initial_weight: 0.0,
+        },
         beta: 20.0,
         max_steps: 1000,
         start: StartMode::UniformInBox,
@@ -320,7 +359,10 @@ impl<'a> ArmsLatent<'a> {
             });
         }
         let learner = Learner::new(config, self.low, self.high, &orthogonal_and_diagonal_actions_2d())?;
-        let space = StateSpace::Latent { decoder: self.decoder, encoder: self.encoder };
+        let space = StateSpace::Latent {
+            decoder: self.decoder,
+            encoder: self.encoder,
+        };
         learner.check_space(&space, posture_dim)?;
         Ok((learner, space))
     }
@@ -365,30 +407,76 @@ mod tests {
     fn violations_reward_and_band() {
         let c = ArmsConfig::default();
         assert_eq!(c.violation(&[-0.2, 0.2, -0.1, 0.2]), None);
-        assert_eq!(c.violation(&[-0.2, 0.33, -0.1, 0.33]), None, "left hand in the gap, right hand in the gap");
-        assert_eq!(c.violation(&[-0.4, 0.33, -0.3, 0.33]), Some(EndReason::Obstacle), "left hand in the left wall");
-        assert_eq!(c.violation(&[-0.1, 0.30, 0.0, 0.30]), Some(EndReason::Obstacle), "right hand on the right wall's edge");
+        assert_eq!(
+            c.violation(&[-0.2, 0.33, -0.1, 0.33]),
+            None,
+            "left hand in the gap, right hand in the gap"
+        );
+        assert_eq!(
+            c.violation(&[-0.4, 0.33, -0.3, 0.33]),
+            Some(EndReason::Obstacle),
+            "left hand in the left wall"
+        );
+        assert_eq!(
+            c.violation(&[-0.1, 0.30, 0.0, 0.30]),
+            Some(EndReason::Obstacle),
+            "right hand on the right wall's edge"
+        );
         assert_eq!(c.violation(&[-0.2, 0.2, -0.094, 0.2]), Some(EndReason::Drop));
         assert_eq!(c.violation(&[-0.2, 0.2, -0.096, 0.2]), None, "within 5 mm");
         assert_eq!(c.reward(&c.target), 1.0);
         let h = [0.25, 0.47, 0.35, 0.47];
-        assert!((c.reward(&h) - (-0.35 * 2.0f64).exp()).abs() < 1e-15, "0.3 m per hand = ℓ");
+        assert!(
+            (c.reward(&h) - (-0.35 * 2.0f64).exp()).abs() < 1e-15,
+            "0.3 m per hand = ℓ"
+        );
         assert!((c.rms_hand_distance(&h) - 0.3).abs() < 1e-15);
         assert_eq!(c.wall_band(), Some((0.30, 0.37)));
-        assert_eq!(ArmsConfig { walls: vec![], ..ArmsConfig::default() }.wall_band(), None);
+        assert_eq!(
+            ArmsConfig {
+                walls: vec![],
+                ..ArmsConfig::default()
+            }
+            .wall_band(),
+            None
+        );
     }
 
     #[test]
     fn bad_config_is_an_error() {
         let bad = [
-            ArmsConfig { theta: 0.0, ..ArmsConfig::default() },
-            ArmsConfig { length_scale: f64::NAN, ..ArmsConfig::default() },
-            ArmsConfig { drop_tolerance: -1.0, ..ArmsConfig::default() },
-            ArmsConfig { walls: vec![Wall { low: [0.0, 0.0], high: [1.0, 0.0] }], ..ArmsConfig::default() },
-            ArmsConfig { target: [0.0, f64::INFINITY, 0.0, 0.0], ..ArmsConfig::default() },
+            ArmsConfig {
+                theta: 0.0,
+                ..ArmsConfig::default()
+            },
+            ArmsConfig {
+                length_scale: f64::NAN,
+                ..ArmsConfig::default()
+            },
+            ArmsConfig {
+                drop_tolerance: -1.0,
+                ..ArmsConfig::default()
+            },
+            ArmsConfig {
+                walls: vec![Wall {
+                    low: [0.0, 0.0],
+                    high: [1.0, 0.0],
+                }],
+                ..ArmsConfig::default()
+            },
+            ArmsConfig {
+                target: [0.0, f64::INFINITY, 0.0, 0.0],
+                ..ArmsConfig::default()
+            },
         ];
         for c in bad {
-            assert!(matches!(c.validate(), Err(SimError::InvalidParameter { .. } | SimError::NonFinite { .. })), "{c:?}");
+            assert!(
+                matches!(
+                    c.validate(),
+                    Err(SimError::InvalidParameter { .. } | SimError::NonFinite { .. })
+                ),
+                "{c:?}"
+            );
         }
     }
 }

@@ -16,11 +16,11 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
-use latent_core::episode::{EndReason, Learner, LearnerConfig, Plant, StateSpace, StepOutcome};
-use latent_core::error::{check_finite, check_positive, CoreError, Result};
-use latent_core::policy::orthogonal_actions;
-use latent_core::trials::{run_trials, TrialOptions, TrialResult};
 use latent_core::GpMap;
+use latent_core::episode::{EndReason, Learner, LearnerConfig, Plant, StateSpace, StepOutcome};
+use latent_core::error::{CoreError, Result, check_finite, check_positive};
+use latent_core::policy::orthogonal_actions;
+use latent_core::trials::{TrialOptions, TrialResult, run_trials};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
@@ -87,7 +87,11 @@ impl BimanualConfig {
         check_positive("reached_rms", self.reached_rms)?;
         for (name, value) in [("obstacle_radius", self.obstacle_radius), ("start_sd", self.start_sd)] {
             if !(value.is_finite() && value >= 0.0) {
-                return Err(CoreError::InvalidParameter { name, value, reason: "must be finite and >= 0" });
+                return Err(CoreError::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be finite and >= 0",
+                });
             }
         }
         check_finite("box_low/box_high", &[self.box_low, self.box_high])?;
@@ -151,7 +155,10 @@ impl BimanualPlant {
     pub fn new(config: BimanualConfig) -> Result<Self> {
         config.validate()?;
         let [x, y] = config.start_mean;
-        Ok(Self { config, state: [x, y, x + config.grip[0], y + config.grip[1]] })
+        Ok(Self {
+            config,
+            state: [x, y, x + config.grip[0], y + config.grip[1]],
+        })
     }
 
     /// Its configuration.
@@ -245,9 +252,17 @@ impl<'a> BimanualLearner<'a> {
         match *self {
             Self::Full => {
                 let (low, high) = plant.posture_box();
-                Ok((Learner::new(config, &low, &high, &full_space_actions())?, StateSpace::Full))
+                Ok((
+                    Learner::new(config, &low, &high, &full_space_actions())?,
+                    StateSpace::Full,
+                ))
             }
-            Self::Latent { decoder, encoder, low, high } => {
+            Self::Latent {
+                decoder,
+                encoder,
+                low,
+                high,
+            } => {
                 let learner = Learner::new(config, low, high, &orthogonal_actions(low.len()))?;
                 let space = StateSpace::Latent { decoder, encoder };
                 learner.check_space(&space, 4)?;
@@ -282,11 +297,18 @@ mod tests {
         let c = BimanualConfig::default();
         assert_eq!(c.violation(&[1.0, 1.0, 1.1, 1.0]), None);
         assert_eq!(c.violation(&[0.5, 0.45, 0.6, 0.45]), Some(EndReason::Obstacle));
-        assert_eq!(c.violation(&[0.2, 0.5, 0.3, 0.5]), None, "left hand 0.3 from the centre, right 0.2: on the rim");
+        assert_eq!(
+            c.violation(&[0.2, 0.5, 0.3, 0.5]),
+            None,
+            "left hand 0.3 from the centre, right 0.2: on the rim"
+        );
         assert_eq!(c.violation(&[1.45, 1.0, 1.55, 1.0]), Some(EndReason::BoxExit));
         assert_eq!(c.violation(&[1.0, 1.0, 1.25, 1.0]), Some(EndReason::Drop));
         assert_eq!(c.violation(&[1.0, 1.0, 1.19, 1.0]), None, "within the 0.1 tolerance");
-        let strict = BimanualConfig { drop_tolerance: 0.005, ..c };
+        let strict = BimanualConfig {
+            drop_tolerance: 0.005,
+            ..c
+        };
         assert_eq!(strict.violation(&[1.0, 1.0, 1.11, 1.0]), Some(EndReason::Drop));
         assert_eq!(c.reward(&c.target), 1.0);
         assert!((c.reward(&[1.0, 1.0, 1.1, 1.0]) - (-3.0f64).exp()).abs() < 1e-15);
@@ -342,7 +364,9 @@ mod tests {
 
     #[test]
     fn full_learner_step_is_0_021() {
-        let (learner, _) = BimanualLearner::Full.build(&BimanualConfig::default(), &LearnerConfig::default()).unwrap();
+        let (learner, _) = BimanualLearner::Full
+            .build(&BimanualConfig::default(), &LearnerConfig::default())
+            .unwrap();
         assert_eq!(learner.grid().len(), 160_000);
         let d = learner.displacements();
         assert!((d[0] - 0.2 * 2.0 / 19.0).abs() < 1e-15);
@@ -351,10 +375,22 @@ mod tests {
     #[test]
     fn bad_config_is_an_error() {
         for c in [
-            BimanualConfig { drop_tolerance: 0.0, ..Default::default() },
-            BimanualConfig { box_high: -1.0, ..Default::default() },
-            BimanualConfig { start_sd: -0.1, ..Default::default() },
-            BimanualConfig { target: [f64::NAN, 0.0, 0.0, 0.0], ..Default::default() },
+            BimanualConfig {
+                drop_tolerance: 0.0,
+                ..Default::default()
+            },
+            BimanualConfig {
+                box_high: -1.0,
+                ..Default::default()
+            },
+            BimanualConfig {
+                start_sd: -0.1,
+                ..Default::default()
+            },
+            BimanualConfig {
+                target: [f64::NAN, 0.0, 0.0, 0.0],
+                ..Default::default()
+            },
         ] {
             assert!(BimanualPlant::new(c).is_err());
         }

@@ -133,7 +133,11 @@ pub type Result<T> = std::result::Result<T, SimError>;
 /// Fails with [`SimError::NonFinite`] at the first NaN or infinity in `values`.
 pub fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
-        Some(index) => Err(SimError::NonFinite { what, index, value: values[index] }),
+        Some(index) => Err(SimError::NonFinite {
+            what,
+            index,
+            value: values[index],
+        }),
         None => Ok(()),
     }
 }

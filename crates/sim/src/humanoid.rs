@@ -121,10 +121,7 @@ fn box_corners(sim: &PhysicsSim, model: &UrdfModel, link: &str) -> Result<Vec<Po
             let [sx, sy, sz] = size.0;
             let [x, y, z] = c.origin.xyz.0;
             let [r, p, w] = c.origin.rpy.0;
-            let local = Isometry3::from_parts(
-                Translation3::new(x, y, z),
-                UnitQuaternion::from_euler_angles(r, p, w),
-            );
+            let local = Isometry3::from_parts(Translation3::new(x, y, z), UnitQuaternion::from_euler_angles(r, p, w));
             for i in 0..8 {
                 let sign = |bit: usize| if i & bit == 0 { -0.5 } else { 0.5 };
                 let corner = Point3::new(sign(1) * sx, sign(2) * sy, sign(4) * sz);
@@ -142,9 +139,7 @@ fn convex_hull(mut pts: Vec<Point2<f64>>) -> Vec<Point2<f64>> {
     if pts.len() < 3 {
         return pts;
     }
-    let cross = |o: Point2<f64>, a: Point2<f64>, b: Point2<f64>| {
-        (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
-    };
+    let cross = |o: Point2<f64>, a: Point2<f64>, b: Point2<f64>| (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
     let mut hull: Vec<Point2<f64>> = Vec::with_capacity(2 * pts.len());
     for pass in 0..2 {
         let start = hull.len();
@@ -154,9 +149,7 @@ fn convex_hull(mut pts: Vec<Point2<f64>>) -> Vec<Point2<f64>> {
             Box::new(pts.iter().rev())
         };
         for &p in iter {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
-            {
+            while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
                 hull.pop();
             }
             hull.push(p);
@@ -215,22 +208,13 @@ pub fn support_margin(sim: &PhysicsSim, soles: &[String]) -> Result<f64> {
         .map(|c| Point2::new(c.x, c.y))
         .collect();
     let com = center_of_mass(sim)?;
-    Ok(polygon_margin(
-        Point2::new(com.x, com.y),
-        &convex_hull(touching),
-    ))
+    Ok(polygon_margin(Point2::new(com.x, com.y), &convex_hull(touching)))
 }
 
 /// Resets the robot to `posture` with the first sole flat on the ground: the base is
 /// placed so that this sole's frame keeps its x–y position and heading at the identity
 /// base, with no roll or pitch, and its lowest box corner `clearance` (m) above `ground`.
-pub fn reset_on_ground(
-    sim: &mut PhysicsSim,
-    posture: &[f64],
-    sole: &str,
-    ground: f64,
-    clearance: f64,
-) -> Result<()> {
+pub fn reset_on_ground(sim: &mut PhysicsSim, posture: &[f64], sole: &str, ground: f64, clearance: f64) -> Result<()> {
     sim.reset_with_base(posture, &Isometry3::identity())?;
     let sole_pose = sim.link_pose(sole)?;
     let (_, _, yaw) = sole_pose.rotation.euler_angles();

@@ -13,7 +13,7 @@
 //!   shoulder, so postures stay continuous (no 2π jumps) for every hand target in front of
 //!   or beside the body (PITFALLS.md, "IK angle continuity").
 
-use crate::error::{check_finite, Result, SimError};
+use crate::error::{Result, SimError, check_finite};
 
 /// Geometry of the two arms. Every length is in metres, every angle in radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,7 +61,11 @@ impl PlanarArms {
     pub fn validate(&self) -> Result<()> {
         for (name, value) in [("upper_arm", self.upper_arm), ("forearm", self.forearm)] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(SimError::InvalidParameter { name, value, reason: "must be finite and > 0" });
+                return Err(SimError::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be finite and > 0",
+                });
             }
         }
         let others = [
@@ -73,7 +77,11 @@ impl PlanarArms {
         ];
         for (name, value) in others {
             if !value.is_finite() {
-                return Err(SimError::InvalidParameter { name, value, reason: "must be finite" });
+                return Err(SimError::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be finite",
+                });
             }
         }
         Ok(())
@@ -86,16 +94,25 @@ impl PlanarArms {
 
     /// Forward kinematics of one arm: (elbow, hand) for shoulder angle `q1`, elbow angle `q2`.
     fn arm_forward(&self, shoulder: [f64; 2], q1: f64, q2: f64) -> ([f64; 2], [f64; 2]) {
-        let elbow = [shoulder[0] + self.upper_arm * q1.cos(), shoulder[1] + self.upper_arm * q1.sin()];
+        let elbow = [
+            shoulder[0] + self.upper_arm * q1.cos(),
+            shoulder[1] + self.upper_arm * q1.sin(),
+        ];
         let q12 = q1 + q2;
-        (elbow, [elbow[0] + self.forearm * q12.cos(), elbow[1] + self.forearm * q12.sin()])
+        (
+            elbow,
+            [elbow[0] + self.forearm * q12.cos(), elbow[1] + self.forearm * q12.sin()],
+        )
     }
 
     /// Hands and elbows of `posture` `[q1_L, q2_L, q1_R, q2_R]`.
     pub fn forward(&self, posture: &[f64; 4]) -> ArmsPose {
         let (el, hl) = self.arm_forward(self.left_shoulder, posture[0], posture[1]);
         let (er, hr) = self.arm_forward(self.right_shoulder, posture[2], posture[3]);
-        ArmsPose { hands: [hl[0], hl[1], hr[0], hr[1]], elbows: [el[0], el[1], er[0], er[1]] }
+        ArmsPose {
+            hands: [hl[0], hl[1], hr[0], hr[1]],
+            elbows: [el[0], el[1], er[0], er[1]],
+        }
     }
 
     /// Hands `[x_L, y_L, x_R, y_R]` of `posture` (the hot part of [`Self::forward`]).
@@ -104,14 +121,27 @@ impl PlanarArms {
     }
 
     /// Analytic inverse of one arm for `hand`, elbow angle sign `branch` (±1).
-    fn arm_inverse(&self, shoulder: [f64; 2], hand: [f64; 2], branch: f64, arm: &'static str, row: usize) -> Result<[f64; 2]> {
+    fn arm_inverse(
+        &self,
+        shoulder: [f64; 2],
+        hand: [f64; 2],
+        branch: f64,
+        arm: &'static str,
+        row: usize,
+    ) -> Result<[f64; 2]> {
         let (l1, l2) = (self.upper_arm, self.forearm);
         let (dx, dy) = (hand[0] - shoulder[0], hand[1] - shoulder[1]);
         let distance = dx.hypot(dy);
         let (min, max) = self.reach();
         let slack = REACH_SLACK * max;
         if distance > max + slack || distance < min - slack {
-            return Err(SimError::Unreachable { arm, row, distance, min, max });
+            return Err(SimError::Unreachable {
+                arm,
+                row,
+                distance,
+                min,
+                max,
+            });
         }
         let cos_q2 = ((distance * distance - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)).clamp(-1.0, 1.0);
         let q2 = branch * cos_q2.acos();
@@ -138,13 +168,19 @@ impl PlanarArms {
     /// Forward kinematics of a row-major `(N, 4)` batch of postures → `(N, 4)` hands.
     pub fn forward_batch(&self, postures: &[f64]) -> Result<Vec<f64>> {
         check_rows("postures", postures)?;
-        Ok(postures.chunks_exact(4).flat_map(|p| self.hands(&[p[0], p[1], p[2], p[3]])).collect())
+        Ok(postures
+            .chunks_exact(4)
+            .flat_map(|p| self.hands(&[p[0], p[1], p[2], p[3]]))
+            .collect())
     }
 
     /// Elbow positions of a row-major `(N, 4)` batch of postures → `(N, 4)` elbows.
     pub fn elbows_batch(&self, postures: &[f64]) -> Result<Vec<f64>> {
         check_rows("postures", postures)?;
-        Ok(postures.chunks_exact(4).flat_map(|p| self.forward(&[p[0], p[1], p[2], p[3]]).elbows).collect())
+        Ok(postures
+            .chunks_exact(4)
+            .flat_map(|p| self.forward(&[p[0], p[1], p[2], p[3]]).elbows)
+            .collect())
     }
 
     /// Inverse kinematics of a row-major `(N, 4)` batch of hand targets → `(N, 4)` postures;
@@ -195,7 +231,11 @@ mod tests {
         let bent = arms.forward(&[PI, -FRAC_PI_2, 0.0, FRAC_PI_2]);
         assert!(close(&bent.elbows, &[-0.45, 0.0, 0.45, 0.0], 1e-12));
         assert!(close(&bent.hands, &[-0.45, 0.3, 0.45, 0.3], 1e-12));
-        assert_eq!(arms.inverse(&bent.hands, 0).map(|q| close(&q, &[PI, -FRAC_PI_2, 0.0, FRAC_PI_2], 1e-12)), Ok(true));
+        assert_eq!(
+            arms.inverse(&bent.hands, 0)
+                .map(|q| close(&q, &[PI, -FRAC_PI_2, 0.0, FRAC_PI_2], 1e-12)),
+            Ok(true)
+        );
     }
 
     #[test]
@@ -243,9 +283,29 @@ mod tests {
     fn unreachable_and_bad_input() {
         let arms = PlanarArms::default();
         let far = arms.inverse(&[-0.15, 0.7, 0.0, 0.3], 3);
-        assert!(matches!(far, Err(SimError::Unreachable { arm: "left", row: 3, .. })), "{far:?}");
+        assert!(
+            matches!(
+                far,
+                Err(SimError::Unreachable {
+                    arm: "left",
+                    row: 3,
+                    ..
+                })
+            ),
+            "{far:?}"
+        );
         let far_right = arms.inverse_batch(&[0.0, 0.3, 0.1, 0.3, 0.0, 0.3, 0.9, 0.0]);
-        assert!(matches!(far_right, Err(SimError::Unreachable { arm: "right", row: 1, .. })), "{far_right:?}");
+        assert!(
+            matches!(
+                far_right,
+                Err(SimError::Unreachable {
+                    arm: "right",
+                    row: 1,
+                    ..
+                })
+            ),
+            "{far_right:?}"
+        );
         // Exactly at full stretch is reachable (rounding slack).
         assert!(arms.inverse(&[-0.15, 0.6, 0.15, 0.6], 0).is_ok());
         assert!(matches!(arms.forward_batch(&[0.0; 5]), Err(SimError::Shape { .. })));
@@ -254,8 +314,14 @@ mod tests {
             arms.inverse_batch(&[0.0, 0.3, f64::NAN, 0.3]),
             Err(SimError::NonFinite { index: 2, .. })
         ));
-        let bad = PlanarArms { forearm: 0.0, ..PlanarArms::default() };
-        assert!(matches!(bad.validate(), Err(SimError::InvalidParameter { name: "forearm", .. })));
+        let bad = PlanarArms {
+            forearm: 0.0,
+            ..PlanarArms::default()
+        };
+        assert!(matches!(
+            bad.validate(),
+            Err(SimError::InvalidParameter { name: "forearm", .. })
+        ));
     }
 
     #[test]
@@ -265,7 +331,12 @@ mod tests {
         let hands = arms.forward_batch(&postures).unwrap();
         let elbows = arms.elbows_batch(&postures).unwrap();
         for r in 0..2 {
-            let p = [postures[4 * r], postures[4 * r + 1], postures[4 * r + 2], postures[4 * r + 3]];
+            let p = [
+                postures[4 * r],
+                postures[4 * r + 1],
+                postures[4 * r + 2],
+                postures[4 * r + 3],
+            ];
             let pose = arms.forward(&p);
             assert_eq!(&hands[4 * r..4 * r + 4], &pose.hands);
             assert_eq!(&elbows[4 * r..4 * r + 4], &pose.elbows);

@@ -166,10 +166,7 @@ impl PhysicsSim {
         let (Some(pa), Some(pb)) = (self.collider_pose(a), self.collider_pose(b)) else {
             return f64::INFINITY;
         };
-        let (sa, sb) = (
-            self.world.colliders[a].shape(),
-            self.world.colliders[b].shape(),
-        );
+        let (sa, sb) = (self.world.colliders[a].shape(), self.world.colliders[b].shape());
         distance(&pa, sa, &pb, sb).map_or(f64::INFINITY, |d| d.distance.max(0.0) as f64)
     }
 
@@ -207,19 +204,12 @@ impl PhysicsSim {
                     link: names[*link].to_string(),
                     obstacle: id,
                 };
-                if !out.contains(&contact)
-                    && self.pair_distance(*c, obs.collider) <= self.options.contact_margin
-                {
+                if !out.contains(&contact) && self.pair_distance(*c, obs.collider) <= self.options.contact_margin {
                     out.push(contact);
                 }
             }
         }
-        out.sort_by_key(|c| {
-            (
-                self.model.link_index(&c.link).unwrap_or(usize::MAX),
-                c.obstacle,
-            )
-        });
+        out.sort_by_key(|c| (self.model.link_index(&c.link).unwrap_or(usize::MAX), c.obstacle));
         out
     }
 
@@ -285,9 +275,8 @@ impl PhysicsSim {
                 break;
             }
         }
-        let fell = base_height < criteria.min_base_height
-            || sole_tilt > criteria.max_sole_tilt
-            || ground_contact.is_some();
+        let fell =
+            base_height < criteria.min_base_height || sole_tilt > criteria.max_sole_tilt || ground_contact.is_some();
         Ok(FallStatus {
             fell,
             base_height,

@@ -10,9 +10,7 @@
 //! crossing this API is f64.
 
 use nalgebra::Isometry3;
-use rapier3d::prelude::{
-    ColliderBuilder, ColliderHandle, PhysicsWorld, Real, RigidBodyHandle, SharedShape, Vector,
-};
+use rapier3d::prelude::{ColliderBuilder, ColliderHandle, PhysicsWorld, Real, RigidBodyHandle, SharedShape, Vector};
 
 use crate::error::{Result, SimError, check_finite};
 use crate::obstacles::ObstacleEntry;
@@ -52,8 +50,8 @@ impl PhysicsSim {
         world.integration_parameters.num_solver_iterations = options.solver_iterations;
         let robot = model.insert(&mut world, options.root, options.self_collisions)?;
         let ground = options.ground.map(|z| {
-            let plane = ColliderBuilder::new(SharedShape::halfspace(Vector::Z))
-                .translation(Vector::new(0.0, 0.0, z as Real));
+            let plane =
+                ColliderBuilder::new(SharedShape::halfspace(Vector::Z)).translation(Vector::new(0.0, 0.0, z as Real));
             world.colliders.insert(plane)
         });
         let mut gains = Vec::with_capacity(model.joints().len());
@@ -69,11 +67,7 @@ impl PhysicsSim {
             }
         }
         let n = model.joints().len();
-        let start: Vec<f64> = model
-            .joints()
-            .iter()
-            .map(|j| 0.0_f64.clamp(j.lower, j.upper))
-            .collect();
+        let start: Vec<f64> = model.joints().iter().map(|j| 0.0_f64.clamp(j.lower, j.upper)).collect();
         let mut sim = Self {
             world,
             model,

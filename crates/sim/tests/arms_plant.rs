@@ -8,8 +8,8 @@ use latent_core::episode::{EndReason, LearnerConfig, Plant, StartMode};
 use latent_core::trials::{TrialOptions, TrialResult};
 use latent_core::{GpMap, SeKernel};
 use nalgebra::DMatrix;
-use sim::arms::{run_arms_trials, ArmsConfig, ArmsLatent, ArmsPlant};
 use sim::PlanarArms;
+use sim::arms::{ArmsConfig, ArmsLatent, ArmsPlant, run_arms_trials};
 
 fn plant(config: ArmsConfig) -> ArmsPlant {
     ArmsPlant::new(common::arms_model(), config).expect("arms plant builds")
@@ -17,7 +17,9 @@ fn plant(config: ArmsConfig) -> ArmsPlant {
 
 /// The posture (elbows outward) with the left hand at `(x, y)` and the right hand 0.1 m to its right.
 fn holding(x: f64, y: f64) -> [f64; 4] {
-    PlanarArms::default().inverse(&[x, y, x + 0.1, y], 0).expect("reachable")
+    PlanarArms::default()
+        .inverse(&[x, y, x + 0.1, y], 0)
+        .expect("reachable")
 }
 
 fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
@@ -34,7 +36,11 @@ fn walk(p: &mut ArmsPlant, from: (f64, f64), to: (f64, f64), n: usize) -> (Vec<(
         let t = k as f64 / n as f64;
         let target = holding(from.0 + t * (to.0 - from.0), from.1 + t * (to.1 - from.1));
         let out = p.step(&target, &mut reached);
-        worst = target.iter().zip(&reached).map(|(a, b)| (a - b).abs()).fold(worst, f64::max);
+        worst = target
+            .iter()
+            .zip(&reached)
+            .map(|(a, b)| (a - b).abs())
+            .fold(worst, f64::max);
         outcomes.push((out.reward, out.end));
         if out.end.is_some() {
             break;
@@ -57,8 +63,16 @@ fn a_held_posture_stays_put_and_pays_the_formula() {
         assert!(close(&reached, &q, 1e-4), "{reached:?} vs {q:?}");
         assert!(close(&h, &expected_hands, 1e-4), "{h:?} vs {expected_hands:?}");
         // Reward (SPEC §4.2): exp(−0.35 ‖(h − h*)/0.3‖²) of the sim's hand frames.
-        let d2: f64 = h.iter().zip([-0.05, 0.47, 0.05, 0.47]).map(|(a, b)| (a - b) * (a - b)).sum();
-        assert!((out.reward - (-0.35 * d2 / 0.09).exp()).abs() < 1e-12, "{} vs formula", out.reward);
+        let d2: f64 = h
+            .iter()
+            .zip([-0.05, 0.47, 0.05, 0.47])
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum();
+        assert!(
+            (out.reward - (-0.35 * d2 / 0.09).exp()).abs() < 1e-12,
+            "{} vs formula",
+            out.reward
+        );
     }
     let mut task = [0.0; 4];
     p.task_position(&mut task);
@@ -74,7 +88,10 @@ fn hands_match_the_kinematics_of_the_reached_posture() {
     assert!(outcomes.iter().all(|(_, end)| end.is_none()));
     let mut q = [0.0; 4];
     p.sim().joint_positions_into(&mut q);
-    assert!(close(&p.hands(), &PlanarArms::default().hands(&q), 1e-5), "f32 world vs f64 FK");
+    assert!(
+        close(&p.hands(), &PlanarArms::default().hands(&q), 1e-5),
+        "f32 world vs f64 FK"
+    );
 }
 
 #[test]
@@ -105,8 +122,14 @@ fn a_target_inside_the_corridor_wall_ends_with_obstacle() {
     let (reward, end) = *outcomes.last().unwrap();
     assert_eq!(end, Some(EndReason::Obstacle), "{outcomes:?}");
     let h = p.hands();
-    assert!((0.30..=0.37).contains(&h[1]) && h[0] <= -0.36, "left hand in the left wall: {h:?}");
-    assert!((reward - (p.config().reward(&h) - 1.0)).abs() < 1e-12, "reward + penalty");
+    assert!(
+        (0.30..=0.37).contains(&h[1]) && h[0] <= -0.36,
+        "left hand in the left wall: {h:?}"
+    );
+    assert!(
+        (reward - (p.config().reward(&h) - 1.0)).abs() < 1e-12,
+        "reward + penalty"
+    );
     assert!(!p.passed());
 }
 
@@ -133,17 +156,30 @@ fn inadmissible_starts_are_refused() {
     assert_eq!(p.reset(&holding(-0.4, 0.33)), Some(EndReason::Obstacle));
     let loose = PlanarArms::default().inverse(&[-0.2, 0.2, -0.05, 0.2], 0).unwrap();
     assert_eq!(p.reset(&loose), Some(EndReason::Drop));
-    assert_eq!(p.reset(&[9.0, 0.0, 0.0, 0.0]), Some(EndReason::BoxExit), "outside the joint limits");
+    assert_eq!(
+        p.reset(&[9.0, 0.0, 0.0, 0.0]),
+        Some(EndReason::BoxExit),
+        "outside the joint limits"
+    );
     assert_eq!(p.reset(&holding(-0.2, 0.2)), None);
 }
 
 #[test]
 fn bad_hand_links_and_configs_fail_to_build() {
-    let bad = ArmsConfig { left_hand: "left_paw".to_string(), ..ArmsConfig::default() };
+    let bad = ArmsConfig {
+        left_hand: "left_paw".to_string(),
+        ..ArmsConfig::default()
+    };
     assert!(ArmsPlant::new(common::arms_model(), bad).is_err());
-    let bad = ArmsConfig { start_posture: [9.0, 0.0, 0.0, 0.0], ..ArmsConfig::default() };
+    let bad = ArmsConfig {
+        start_posture: [9.0, 0.0, 0.0, 0.0],
+        ..ArmsConfig::default()
+    };
     assert!(ArmsPlant::new(common::arms_model(), bad).is_err());
-    let bad = ArmsConfig { theta: -1.0, ..ArmsConfig::default() };
+    let bad = ArmsConfig {
+        theta: -1.0,
+        ..ArmsConfig::default()
+    };
     assert!(ArmsPlant::new(common::arms_model(), bad).is_err());
 }
 
@@ -152,18 +188,26 @@ fn bad_hand_links_and_configs_fail_to_build() {
 fn gap_maps() -> (GpMap, GpMap) {
     let side = 9;
     let n = side * side;
-    let z = DMatrix::from_fn(2, n, |i, j| (if i == 0 { j % side } else { j / side }) as f64 / (side - 1) as f64);
+    let z = DMatrix::from_fn(2, n, |i, j| {
+        (if i == 0 { j % side } else { j / side }) as f64 / (side - 1) as f64
+    });
     let mut x = DMatrix::zeros(4, n);
     for j in 0..n {
         let q = holding(-0.3 + 0.2 * z[(0, j)], 0.12 + 0.33 * z[(1, j)]);
         x.column_mut(j).copy_from_slice(&q);
     }
     let kernel = SeKernel::new([1.0, 0.1, 1e-6]).unwrap();
-    (GpMap::new(z.clone(), x.clone(), kernel).unwrap(), GpMap::new(x, z, kernel).unwrap())
+    (
+        GpMap::new(z.clone(), x.clone(), kernel).unwrap(),
+        GpMap::new(x, z, kernel).unwrap(),
+    )
 }
 
 fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
-    let plant = ArmsConfig { drop_tolerance: 0.02, ..ArmsConfig::default() };
+    let plant = ArmsConfig {
+        drop_tolerance: 0.02,
+        ..ArmsConfig::default()
+    };
     let config = LearnerConfig {
         max_steps: 60,
         step_fraction: 0.5,
@@ -171,7 +215,12 @@ fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
         start: StartMode::UniformInBox,
         ..LearnerConfig::default()
     };
-    let latent = ArmsLatent { decoder, encoder, low: &[0.0, 0.0], high: &[1.0, 1.0] };
+    let latent = ArmsLatent {
+        decoder,
+        encoder,
+        low: &[0.0, 0.0],
+        high: &[1.0, 1.0],
+    };
     let options = TrialOptions {
         n_trials: 2,
         episodes: 6,
@@ -185,7 +234,17 @@ fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
     let done = AtomicUsize::new(0);
     let model = common::arms_model();
     let results = pool
-        .install(|| run_arms_trials(&model, &plant, &config, &latent, &options, &AtomicBool::new(false), &done))
+        .install(|| {
+            run_arms_trials(
+                &model,
+                &plant,
+                &config,
+                &latent,
+                &options,
+                &AtomicBool::new(false),
+                &done,
+            )
+        })
         .unwrap();
     assert_eq!(done.into_inner(), 2 * (6 + 4));
     results
@@ -201,7 +260,11 @@ fn trials_run_test_episodes_from_below_the_wall_and_repeat_bitwise() {
         assert!(r.finished);
         assert_eq!((r.episodes.len(), r.tests.len(), r.test_trajectories.len()), (6, 4, 2));
         for path in &r.test_trajectories {
-            assert!(path[1] < 0.30 && path[3] < 0.30, "test start above the wall band: {:?}", &path[..4]);
+            assert!(
+                path[1] < 0.30 && path[3] < 0.30,
+                "test start above the wall band: {:?}",
+                &path[..4]
+            );
         }
         for rec in r.tests.iter().chain(&r.episodes) {
             assert!(rec.steps >= 1 && rec.steps <= 60);

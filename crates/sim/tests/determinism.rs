@@ -26,10 +26,7 @@ fn run(seed: u64) -> Vec<u64> {
             }
             sim.set_targets(&target).unwrap();
             sim.step_rl();
-            let state = sim
-                .joint_positions()
-                .into_iter()
-                .chain(sim.joint_velocities());
+            let state = sim.joint_positions().into_iter().chain(sim.joint_velocities());
             trace.extend(state.map(f64::to_bits));
         }
         trace.push(episode);
@@ -58,10 +55,7 @@ fn reset_to_a_posture_gives_that_posture() {
     // Shoulder angles past π and below −π/2 (inside the limits) are kept as given.
     sim.reset(&[6.0, -3.0, -3.0, 3.0]).unwrap();
     let q = sim.joint_positions();
-    assert!(
-        (q[0] - 6.0).abs() < 1e-6 && (q[2] + 3.0).abs() < 1e-6,
-        "{q:?}"
-    );
+    assert!((q[0] - 6.0).abs() < 1e-6 && (q[2] + 3.0).abs() < 1e-6, "{q:?}");
 }
 
 #[test]

@@ -31,25 +31,15 @@ fn block() -> PhysicsSim {
 #[test]
 fn floating_block_falls_onto_the_ground_and_keeps_moving_its_arm() {
     let mut sim = block();
-    assert_eq!(
-        sim.num_joints(),
-        1,
-        "the free root is not part of the posture"
-    );
+    assert_eq!(sim.num_joints(), 1, "the free root is not part of the posture");
     sim.reset_with_base(&[0.0], &Isometry3::translation(0.1, -0.2, 0.3))
         .unwrap();
     let base = sim.base_pose().translation;
-    assert!(
-        (base.x - 0.1).abs() < 1e-6 && (base.z - 0.3).abs() < 1e-6,
-        "{base:?}"
-    );
+    assert!((base.x - 0.1).abs() < 1e-6 && (base.z - 0.3).abs() < 1e-6, "{base:?}");
     assert!(!sim.touching_ground("base").unwrap());
     sim.step(480);
     let z = sim.base_pose().translation.z;
-    assert!(
-        (z - 0.05).abs() < 5e-3,
-        "the block rests on the ground: z = {z}"
-    );
+    assert!((z - 0.05).abs() < 5e-3, "the block rests on the ground: z = {z}");
     assert!(sim.touching_ground("base").unwrap());
     // Bodies never sleep: a new target after 2 s of rest still moves the arm.
     sim.set_targets(&[0.5]).unwrap();

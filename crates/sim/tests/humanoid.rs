@@ -2,15 +2,10 @@
 //! servo-like PD at its home posture, and the shipped lift demos hold still.
 use std::time::Instant;
 
-use sim::humanoid::{
-    FallCheckConfig, center_of_mass, reset_on_ground, run_fall_check, support_margin,
-};
+use sim::humanoid::{FallCheckConfig, center_of_mass, reset_on_ground, run_fall_check, support_margin};
 use sim::{PdGains, PhysicsSim, RootMode, SimOptions, UrdfModel};
 
-const KHR1HV: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../python/latentrl/data/khr1hv.urdf"
-);
+const KHR1HV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/khr1hv.urdf");
 
 /// Servo gains of the humanoid: kp 8 N·m/rad, kd 0.1 N·m·s/rad, torque capped at the URDF
 /// effort (1.2 N·m), the MuJoCo study's servo (SPEC §4.3).
@@ -30,19 +25,12 @@ fn humanoid(solver_iterations: usize) -> PhysicsSim {
         solver_iterations,
         ..SimOptions::default()
     };
-    PhysicsSim::new(
-        UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"),
-        options,
-    )
-    .expect("builds")
+    PhysicsSim::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
 }
 
 /// Postures of a shipped demo CSV (header of joint names in URDF order, one row each).
 fn demos(file: &str) -> Vec<Vec<f64>> {
-    let path = format!(
-        "{}/../../python/latentrl/data/{file}",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let path = format!("{}/../../python/latentrl/data/{file}", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(path).expect("demo file");
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -63,18 +51,12 @@ fn model_has_the_documented_size_and_mass() {
     let head = sim.link_pose("head").unwrap().translation.z + 0.06;
     assert!((0.339..=0.40).contains(&head), "height {head}");
     let l = sim.link_pose("l_foot").unwrap().translation;
-    assert!(
-        l.z > 0.029 && l.z < 0.031,
-        "ankle 3 cm above the sole: {l:?}"
-    );
+    assert!(l.z > 0.029 && l.z < 0.031, "ankle 3 cm above the sole: {l:?}");
 }
 
 #[test]
 fn every_demo_pose_holds_for_two_seconds() {
-    for (file, heel) in [
-        ("khr1hv_lift_demos.csv", 0.045),
-        ("khr1hv_lift_demos_heel.csv", 0.016),
-    ] {
+    for (file, heel) in [("khr1hv_lift_demos.csv", 0.045), ("khr1hv_lift_demos_heel.csv", 0.016)] {
         for (i, pose) in demos(file).iter().enumerate() {
             let mut sim = humanoid(4);
             let config = FallCheckConfig {
@@ -83,21 +65,12 @@ fn every_demo_pose_holds_for_two_seconds() {
             };
             reset_on_ground(&mut sim, pose, "l_foot", 0.0, 0.0).unwrap();
             let kinematic = support_margin(&sim, &config.soles).unwrap();
-            let r =
-                &run_fall_check(&mut sim, pose, std::slice::from_ref(pose), &config).unwrap()[0];
+            let r = &run_fall_check(&mut sim, pose, std::slice::from_ref(pose), &config).unwrap()[0];
             eprintln!(
                 "{file} pose {i}: kinematic margin {kinematic:.4}, sim min {:.4} final {:.4}, grip {:+.4}, base {:.3}, tilt {:.3}, fell {}",
-                r.min_margin,
-                r.final_margin,
-                r.grip_error,
-                r.status.base_height,
-                r.status.sole_tilt,
-                r.fell
+                r.min_margin, r.final_margin, r.grip_error, r.status.base_height, r.status.sole_tilt, r.fell
             );
-            assert!(
-                (kinematic - heel).abs() < 2e-3,
-                "{file} pose {i}: margin {kinematic}"
-            );
+            assert!((kinematic - heel).abs() < 2e-3, "{file} pose {i}: margin {kinematic}");
             assert!(!r.fell && r.min_margin > 0.005, "{file} pose {i}: {r:?}");
         }
     }

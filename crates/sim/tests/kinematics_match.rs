@@ -41,8 +41,7 @@ fn origin(xyz: [f64; 3], rpy: [f64; 3]) -> Matrix4<f64> {
     let rz = Matrix3::new(cy, -sy, 0.0, sy, cy, 0.0, 0.0, 0.0, 1.0);
     let mut m = Matrix4::identity();
     m.fixed_view_mut::<3, 3>(0, 0).copy_from(&(rz * ry * rx));
-    m.fixed_view_mut::<3, 1>(0, 3)
-        .copy_from(&Vector3::from(xyz));
+    m.fixed_view_mut::<3, 1>(0, 3).copy_from(&Vector3::from(xyz));
     m
 }
 
@@ -108,15 +107,8 @@ fn compound_rpy_chain_matches_independent_fk() {
         let mut t = Matrix4::identity();
         for (i, (xyz, rpy, axis)) in CHAIN.iter().enumerate() {
             t = t * origin(*xyz, *rpy) * about(*axis, q[i]);
-            let got = sim
-                .link_pose(&format!("l{}", i + 1))
-                .unwrap()
-                .to_homogeneous();
-            assert!(
-                (got - t).abs().max() < 1e-5,
-                "link l{}: {got} vs {t}",
-                i + 1
-            );
+            let got = sim.link_pose(&format!("l{}", i + 1)).unwrap().to_homogeneous();
+            assert!((got - t).abs().max() < 1e-5, "link l{}: {got} vs {t}", i + 1);
         }
         let tip = t * origin(TIP.0, TIP.1);
         let got = sim.link_pose("tip").unwrap().to_homogeneous();

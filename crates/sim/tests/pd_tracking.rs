@@ -35,10 +35,7 @@ fn step_of_a_tenth_radian_settles_below_one_milliradian_in_50_ms() {
             "dt = 1/{:.0}, {iterations} iterations: max error after 0.05 s = {err:.3e} rad",
             1.0 / dt
         );
-        assert!(
-            err < 1e-3,
-            "dt {dt}, {iterations} iterations: error {err} rad"
-        );
+        assert!(err < 1e-3, "dt {dt}, {iterations} iterations: error {err} rad");
     }
 }
 
@@ -155,14 +152,9 @@ fn hands_follow_a_moving_target_within_a_millimetre() {
         sim.step_rl();
         let q: [f64; 4] = sim.joint_positions().try_into().unwrap();
         let (want, got) = (arms.hands(&target), arms.hands(&q));
-        let per_hand = |h: &[f64; 4], i: usize| {
-            ((h[i] - want[i]).powi(2) + (h[i + 1] - want[i + 1]).powi(2)).sqrt()
-        };
+        let per_hand = |h: &[f64; 4], i: usize| ((h[i] - want[i]).powi(2) + (h[i + 1] - want[i + 1]).powi(2)).sqrt();
         worst = worst.max(per_hand(&got, 0)).max(per_hand(&got, 2));
     }
-    println!(
-        "largest hand position error after an RL step: {:.3e} m",
-        worst
-    );
+    println!("largest hand position error after an RL step: {:.3e} m", worst);
     assert!(worst < 1e-3, "{worst}");
 }

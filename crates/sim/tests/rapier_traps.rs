@@ -39,21 +39,14 @@ fn detect_collisions_before_the_first_step_freezes_the_robot() {
     for _ in 0..60 {
         world.step();
     }
-    assert!(
-        shoulder_angle(&world, h) > 0.4,
-        "a plain world tracks the motor"
-    );
+    assert!(shoulder_angle(&world, h) > 0.4, "a plain world tracks the motor");
 
     let (mut world, h) = arms_world();
     world.detect_collisions(&(), &());
     for _ in 0..60 {
         world.step();
     }
-    assert_eq!(
-        shoulder_angle(&world, h),
-        0.0,
-        "the trap: the robot never moves"
-    );
+    assert_eq!(shoulder_angle(&world, h), 0.0, "the trap: the robot never moves");
 }
 
 #[test]

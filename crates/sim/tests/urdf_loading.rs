@@ -23,12 +23,7 @@ fn arms_file_has_four_hinges_in_urdf_order() {
     assert_eq!(model.name(), "two_arms");
     assert_eq!(
         model.joint_names(),
-        [
-            "left_shoulder",
-            "left_elbow",
-            "right_shoulder",
-            "right_elbow"
-        ]
+        ["left_shoulder", "left_elbow", "right_shoulder", "right_elbow"]
     );
     let j = &model.joints()[1];
     assert_eq!(j.kind, JointKind::Revolute);
@@ -89,9 +84,7 @@ fn unknown_and_unsupported_joint_types_are_named() {
         );
     }
     // A commented-out joint does not count.
-    let commented = robot(&format!(
-        "<!-- <joint name=\"x\" type=\"hinge\"/> -->{HINGE}"
-    ));
+    let commented = robot(&format!("<!-- <joint name=\"x\" type=\"hinge\"/> -->{HINGE}"));
     assert!(UrdfModel::parse(&commented).is_ok());
 }
 
@@ -139,10 +132,7 @@ fn bad_options_and_inputs_are_rejected() {
         Err(SimError::InvalidParameter { name: "dt", .. })
     ));
     let mut sim = common::arms(SimOptions::default());
-    assert!(matches!(
-        sim.set_targets(&[0.0; 3]),
-        Err(SimError::Shape { .. })
-    ));
+    assert!(matches!(sim.set_targets(&[0.0; 3]), Err(SimError::Shape { .. })));
     assert!(matches!(
         sim.set_targets(&[0.0, f64::NAN, 0.0, 0.0]),
         Err(SimError::NonFinite { index: 1, .. })

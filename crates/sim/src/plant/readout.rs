@@ -38,11 +38,7 @@ impl PhysicsSim {
     /// The joint velocities (rad/s or m/s), URDF order.
     pub fn joint_velocities(&self) -> Vec<f64> {
         let vel = |slot: &JointSlot| {
-            let mb = self
-                .world
-                .multibody_joints
-                .get(slot.handle)
-                .map(|(mb, _)| mb);
+            let mb = self.world.multibody_joints.get(slot.handle).map(|(mb, _)| mb);
             mb.map_or(f64::NAN, |mb| mb.generalized_velocity()[slot.dof] as f64)
         };
         self.slots.iter().map(vel).collect()
@@ -68,9 +64,7 @@ impl PhysicsSim {
         self.world
             .bodies
             .get(frame.body)
-            .map_or_else(Isometry3::identity, |rb| {
-                to_isometry(rb.position()) * frame.offset
-            })
+            .map_or_else(Isometry3::identity, |rb| to_isometry(rb.position()) * frame.offset)
     }
 
     /// World position of `frame` (e.g. a hand).

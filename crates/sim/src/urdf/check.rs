@@ -122,10 +122,7 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
             }
         }
         if !children.insert(joint.child.link.as_str()) {
-            return Err(bad(format!(
-                "link {:?} is the child of two joints",
-                joint.child.link
-            )));
+            return Err(bad(format!("link {:?} is the child of two joints", joint.child.link)));
         }
         if joint.mimic.is_some() {
             return Err(SimError::UnsupportedJointType {
@@ -136,10 +133,7 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
         }
         let pose = joint.origin.xyz.0.iter().chain(joint.origin.rpy.0.iter());
         if pose.chain(joint.axis.xyz.0.iter()).any(|v| !v.is_finite()) {
-            return Err(bad(format!(
-                "joint {:?} has a non-finite origin or axis",
-                joint.name
-            )));
+            return Err(bad(format!("joint {:?} has a non-finite origin or axis", joint.name)));
         }
         let kind = match joint.joint_type {
             urdf_rs::JointType::Revolute => JointKind::Revolute,
@@ -161,9 +155,7 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
             JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
             _ => (joint.limit.lower, joint.limit.upper),
         };
-        if kind != JointKind::Continuous
-            && !(lower.is_finite() && upper.is_finite() && lower < upper)
-        {
+        if kind != JointKind::Continuous && !(lower.is_finite() && upper.is_finite() && lower < upper) {
             return Err(bad(format!(
                 "joint {:?} needs <limit lower upper> with lower < upper, got [{lower}, {upper}]",
                 joint.name
@@ -186,12 +178,8 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
             upper,
             effort: positive(joint.limit.effort),
             velocity: positive(joint.limit.velocity),
-            damping: dynamics
-                .map(|d| d.damping)
-                .filter(|v| v.is_finite() && *v >= 0.0),
-            friction: dynamics
-                .map(|d| d.friction)
-                .filter(|v| v.is_finite() && *v >= 0.0),
+            damping: dynamics.map(|d| d.damping).filter(|v| v.is_finite() && *v >= 0.0),
+            friction: dynamics.map(|d| d.friction).filter(|v| v.is_finite() && *v >= 0.0),
         });
     }
     Ok(actuated)

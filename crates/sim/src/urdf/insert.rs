@@ -5,8 +5,7 @@ use std::path::Path;
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 use rapier3d::prelude::{
-    ColliderHandle, JointAxis, MultibodyJointHandle, PhysicsWorld, Pose, RigidBodyBuilder,
-    RigidBodyHandle,
+    ColliderHandle, JointAxis, MultibodyJointHandle, PhysicsWorld, Pose, RigidBodyBuilder, RigidBodyHandle,
 };
 use rapier3d_urdf::{UrdfLoaderOptions, UrdfMultibodyOptions, UrdfRobot, urdf_rs};
 
@@ -112,15 +111,12 @@ impl UrdfModel {
         let mut slots = Vec::with_capacity(self.joints.len());
         for info in &self.joints {
             let urdf_joint = self.robot.joints.iter().position(|j| j.name == info.name);
-            let k = joint_ids.iter().position(|(id, merged)| {
-                Some(*id) == urdf_joint || merged.iter().any(|m| Some(*m) == urdf_joint)
-            });
-            let handle = k.and_then(|k| handles.joints[k].joint).ok_or_else(|| {
-                bad(format!(
-                    "joint {:?} could not be inserted (kinematic loop?)",
-                    info.name
-                ))
-            })?;
+            let k = joint_ids
+                .iter()
+                .position(|(id, merged)| Some(*id) == urdf_joint || merged.iter().any(|m| Some(*m) == urdf_joint));
+            let handle = k
+                .and_then(|k| handles.joints[k].joint)
+                .ok_or_else(|| bad(format!("joint {:?} could not be inserted (kinematic loop?)", info.name)))?;
             let (mb, link_id) = world
                 .multibody_joints
                 .get_mut(handle)
@@ -171,17 +167,13 @@ impl UrdfModel {
                 .iter()
                 .filter(|j| j.joint_type == urdf_rs::JointType::Fixed)
             {
-                let (Some(parent), Some(child)) =
-                    (index(&joint.parent.link), index(&joint.child.link))
-                else {
+                let (Some(parent), Some(child)) = (index(&joint.parent.link), index(&joint.child.link)) else {
                     continue;
                 };
                 let origin = origin_pose(&joint.origin);
                 match (frames[parent], frames[child]) {
                     (Some((body, pose)), None) => frames[child] = Some((body, pose * origin)),
-                    (None, Some((body, pose))) => {
-                        frames[parent] = Some((body, pose * origin.inverse()))
-                    }
+                    (None, Some((body, pose))) => frames[parent] = Some((body, pose * origin.inverse())),
                     _ => continue,
                 }
                 progress = true;

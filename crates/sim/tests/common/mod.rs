@@ -4,10 +4,7 @@
 use sim::{PhysicsSim, SimOptions, UrdfModel};
 
 /// Path of the shipped two-arm URDF (package data of the Python package).
-pub const TWO_ARMS: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../python/latentrl/data/two_arms.urdf"
-);
+pub const TWO_ARMS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/two_arms.urdf");
 
 /// The two-arm model.
 pub fn arms_model() -> UrdfModel {
