@@ -421,12 +421,22 @@ impl Learner {
         }
     }
 
-    /// Decodes `z` into `posture` (identity in the full space); returns the variance (0 in
-    /// the full space).
+    /// Decodes `z` into `posture` (identity in the full space). Returns the GPLVM variance
+    /// when `with_variance` (for variance gating), else 0: the `O(N²)` solve is skipped.
     #[inline]
-    fn decode(space: &StateSpace<'_>, z: &[f64], posture: &mut [f64], scratch: Option<&mut PredictScratch>) -> f64 {
+    fn decode(
+        space: &StateSpace<'_>,
+        z: &[f64],
+        posture: &mut [f64],
+        scratch: Option<&mut PredictScratch>,
+        with_variance: bool,
+    ) -> f64 {
         match (space, scratch) {
-            (StateSpace::Latent { decoder, .. }, Some(s)) => decoder.predict_into(z, posture, s),
+            (StateSpace::Latent { decoder, .. }, Some(s)) if with_variance => decoder.predict_into(z, posture, s),
+            (StateSpace::Latent { decoder, .. }, Some(s)) => {
+                decoder.mean_into(z, posture, s);
+                0.0
+            }
             _ => {
                 posture.copy_from_slice(z);
                 0.0
@@ -439,7 +449,7 @@ impl Learner {
     fn encode(space: &StateSpace<'_>, posture: &[f64], z: &mut [f64], scratch: Option<&mut PredictScratch>) {
         match (space, scratch) {
             (StateSpace::Latent { encoder, .. }, Some(s)) => {
-                encoder.predict_into(posture, z, s);
+                encoder.mean_into(posture, z, s);
             }
             _ => z.copy_from_slice(posture),
         }
@@ -469,7 +479,8 @@ impl Learner {
                     for (k, z) in s.z.iter_mut().enumerate() {
                         *z = rng.random_range(self.grid.low()[k]..=self.grid.high()[k]);
                     }
-                    let var = Self::decode(space, &s.z, &mut s.reached, s.decode.as_mut());
+                    let gated = self.config.variance_threshold.is_some();
+                    let var = Self::decode(space, &s.z, &mut s.reached, s.decode.as_mut(), gated);
                     let gated = matches!(space, StateSpace::Latent { .. })
                         && self.config.variance_threshold.is_some_and(|t| var > t);
                     admitted = !gated && plant.reset(&s.reached).is_none();
@@ -516,7 +527,8 @@ impl Learner {
             };
         }
         // 3. Decode (and gate on the variance).
-        let var = Self::decode(space, &s.candidate, &mut s.target, s.decode.as_mut());
+        let gated = self.config.variance_threshold.is_some();
+        let var = Self::decode(space, &s.candidate, &mut s.target, s.decode.as_mut(), gated);
         if matches!(space, StateSpace::Latent { .. }) && self.config.variance_threshold.is_some_and(|t| var > t) {
             self.learn(&s.current, penalty, None);
             return StepResult {
