@@ -39,14 +39,13 @@ pub fn to_py(err: CoreError) -> PyErr {
     }
 }
 
-/// Converts a plant error into its Python exception: every `sim` error is bad input.
+/// Converts a plant error into its Python exception: the core's errors as [`to_py`], every
+/// other `sim` error is bad input.
 pub fn sim_to_py(err: SimError) -> PyErr {
     let msg = err.to_string();
     match err {
-        SimError::Shape { .. }
-        | SimError::NonFinite { .. }
-        | SimError::InvalidParameter { .. }
-        | SimError::Unreachable { .. }
+        SimError::Input(core) => to_py(core),
+        SimError::Unreachable { .. }
         | SimError::MissingFile { .. }
         | SimError::MalformedUrdf { .. }
         | SimError::UnsupportedJointType { .. }

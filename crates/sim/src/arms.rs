@@ -138,21 +138,21 @@ impl ArmsConfig {
             ("reached_rms", self.reached_rms),
         ] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(SimError::InvalidParameter {
+                return Err(SimError::Input(CoreError::InvalidParameter {
                     name,
                     value,
                     reason: "must be finite and > 0",
-                });
+                }));
             }
         }
         for wall in &self.walls {
             check_finite("wall corners", &[wall.low[0], wall.low[1], wall.high[0], wall.high[1]])?;
             if let Some(k) = (0..2).find(|&k| wall.high[k] <= wall.low[k]) {
-                return Err(SimError::InvalidParameter {
+                return Err(SimError::Input(CoreError::InvalidParameter {
                     name: "wall high corner",
                     value: wall.high[k],
                     reason: "must exceed the low corner in x and y",
-                });
+                }));
             }
         }
         Ok(())
@@ -473,7 +473,8 @@ mod tests {
             assert!(
                 matches!(
                     c.validate(),
-                    Err(SimError::InvalidParameter { .. } | SimError::NonFinite { .. })
+                    Err(SimError::Input(CoreError::InvalidParameter { .. })
+                        | SimError::Input(CoreError::NonFinite { .. }))
                 ),
                 "{c:?}"
             );

@@ -14,6 +14,7 @@
 //! - **Fall**: [`crate::FallCriteria`] (a sole tilting > 20°, a non-sole link touching
 //!   the ground, or the base height halving).
 
+use latent_core::CoreError;
 use nalgebra::{Isometry3, Point2, Point3, Translation3, UnitQuaternion, Vector3};
 use rapier3d_urdf::urdf_rs;
 
@@ -94,11 +95,11 @@ pub fn center_of_mass(sim: &PhysicsSim) -> Result<Point3<f64>> {
         total += m;
     }
     if total <= 0.0 {
-        return Err(SimError::InvalidParameter {
+        return Err(SimError::Input(CoreError::InvalidParameter {
             name: "mass",
             value: total,
             reason: "the robot has no mass",
-        });
+        }));
     }
     Ok(Point3::from(sum / total))
 }
@@ -229,11 +230,11 @@ pub fn reset_on_ground(sim: &mut PhysicsSim, posture: &[f64], sole: &str, ground
         .map(|c| c.z)
         .fold(f64::INFINITY, f64::min);
     if !lowest.is_finite() {
-        return Err(SimError::InvalidParameter {
+        return Err(SimError::Input(CoreError::InvalidParameter {
             name: "sole",
             value: f64::NAN,
             reason: "the sole link has no box collision shape",
-        });
+        }));
     }
     let lifted = Isometry3::translation(0.0, 0.0, ground + clearance - lowest) * base;
     sim.reset_with_base(posture, &lifted)
@@ -254,11 +255,11 @@ pub fn run_fall_check(
 ) -> Result<Vec<SegmentReport>> {
     check_finite("hold", &[config.hold, config.grip_width])?;
     if config.hold <= 0.0 || config.check_every == 0 {
-        return Err(SimError::InvalidParameter {
+        return Err(SimError::Input(CoreError::InvalidParameter {
             name: "hold",
             value: config.hold,
             reason: "hold must be > 0 and check_every ≥ 1",
-        });
+        }));
     }
     let ground = sim.options.ground.unwrap_or(0.0);
     reset_on_ground(sim, start, &config.soles[0], ground, 5e-4)?;

@@ -14,6 +14,7 @@
 //!   or beside the body (PITFALLS.md, "IK angle continuity").
 
 use crate::error::{Result, SimError, check_finite};
+use latent_core::CoreError;
 
 /// Geometry of the two arms. Every length is in metres, every angle in radians.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,11 +62,11 @@ impl PlanarArms {
     pub fn validate(&self) -> Result<()> {
         for (name, value) in [("upper_arm", self.upper_arm), ("forearm", self.forearm)] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(SimError::InvalidParameter {
+                return Err(SimError::Input(CoreError::InvalidParameter {
                     name,
                     value,
                     reason: "must be finite and > 0",
-                });
+                }));
             }
         }
         let others = [
@@ -77,11 +78,11 @@ impl PlanarArms {
         ];
         for (name, value) in others {
             if !value.is_finite() {
-                return Err(SimError::InvalidParameter {
+                return Err(SimError::Input(CoreError::InvalidParameter {
                     name,
                     value,
                     reason: "must be finite",
-                });
+                }));
             }
         }
         Ok(())
@@ -199,11 +200,11 @@ impl PlanarArms {
 /// A flat row-major `(N, 4)` array: length a multiple of 4, N ≥ 1, all finite.
 fn check_rows(what: &'static str, values: &[f64]) -> Result<()> {
     if values.is_empty() || !values.len().is_multiple_of(4) {
-        return Err(SimError::Shape {
+        return Err(SimError::Input(CoreError::Shape {
             what,
             expected: "(N, 4) with N >= 1".to_string(),
             got: format!("{} values", values.len()),
-        });
+        }));
     }
     check_finite(what, values)
 }
@@ -308,11 +309,17 @@ mod tests {
         );
         // Exactly at full stretch is reachable (rounding slack).
         assert!(arms.inverse(&[-0.15, 0.6, 0.15, 0.6], 0).is_ok());
-        assert!(matches!(arms.forward_batch(&[0.0; 5]), Err(SimError::Shape { .. })));
-        assert!(matches!(arms.forward_batch(&[]), Err(SimError::Shape { .. })));
+        assert!(matches!(
+            arms.forward_batch(&[0.0; 5]),
+            Err(SimError::Input(CoreError::Shape { .. }))
+        ));
+        assert!(matches!(
+            arms.forward_batch(&[]),
+            Err(SimError::Input(CoreError::Shape { .. }))
+        ));
         assert!(matches!(
             arms.inverse_batch(&[0.0, 0.3, f64::NAN, 0.3]),
-            Err(SimError::NonFinite { index: 2, .. })
+            Err(SimError::Input(CoreError::NonFinite { index: 2, .. }))
         ));
         let bad = PlanarArms {
             forearm: 0.0,
@@ -320,7 +327,7 @@ mod tests {
         };
         assert!(matches!(
             bad.validate(),
-            Err(SimError::InvalidParameter { name: "forearm", .. })
+            Err(SimError::Input(CoreError::InvalidParameter { name: "forearm", .. }))
         ));
     }
 

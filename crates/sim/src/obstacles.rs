@@ -12,6 +12,7 @@
 //! Distances are exact for spheres; parry's GJK reads capsule–box gaps ≈ 0.4 mm long
 //! (measured), so the effective margin against boxes is ≈ 0.6 mm at the default 1 mm.
 
+use latent_core::CoreError;
 use nalgebra::Isometry3;
 use rapier3d::math::Rot3;
 use rapier3d::parry::query::distance;
@@ -91,10 +92,12 @@ fn vector(v: [f64; 3]) -> Vector {
 
 impl ObstacleShape {
     fn build(&self) -> Result<SharedShape> {
-        let bad = |name, value| SimError::InvalidParameter {
-            name,
-            value,
-            reason: "must be finite and > 0",
+        let bad = |name, value| {
+            SimError::Input(CoreError::InvalidParameter {
+                name,
+                value,
+                reason: "must be finite and > 0",
+            })
         };
         let positive = |name, v: f64| {
             if v.is_finite() && v > 0.0 {

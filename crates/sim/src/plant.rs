@@ -9,6 +9,7 @@
 //! map to indices with [`PhysicsSim::joint_index`]. rapier computes in f32; every value
 //! crossing this API is f64.
 
+use latent_core::CoreError;
 use nalgebra::Isometry3;
 use rapier3d::prelude::{ColliderBuilder, ColliderHandle, PhysicsWorld, Real, RigidBodyHandle, SharedShape, Vector};
 
@@ -124,11 +125,11 @@ impl PhysicsSim {
     fn check_posture(&self, what: &'static str, values: &[f64]) -> Result<()> {
         if values.len() != self.slots.len() {
             let expected = format!("({},)", self.slots.len());
-            return Err(SimError::Shape {
+            return Err(SimError::Input(CoreError::Shape {
                 what,
                 expected,
                 got: format!("({},)", values.len()),
-            });
+            }));
         }
         check_finite(what, values)
     }

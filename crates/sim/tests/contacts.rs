@@ -1,6 +1,7 @@
 //! Obstacles and contact queries on the two-arm plant.
 mod common;
 
+use latent_core::CoreError;
 use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::Isometry3;
@@ -113,7 +114,7 @@ fn ground_contact_and_bad_obstacles() {
     };
     assert!(matches!(
         sim.add_obstacle(bad),
-        Err(SimError::InvalidParameter { name: "radius", .. })
+        Err(SimError::Input(CoreError::InvalidParameter { name: "radius", .. }))
     ));
     assert!(matches!(
         sim.touching("left_forearm", 7),

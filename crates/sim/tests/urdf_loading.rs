@@ -1,6 +1,7 @@
 //! Loading URDFs: the shipped arms, and each kind of bad input → its `SimError` variant.
 mod common;
 
+use latent_core::CoreError;
 use sim::{JointKind, PhysicsSim, SimError, SimOptions, UrdfModel};
 
 fn robot(body: &str) -> String {
@@ -129,13 +130,16 @@ fn bad_options_and_inputs_are_rejected() {
     };
     assert!(matches!(
         PhysicsSim::new(common::arms_model(), bad),
-        Err(SimError::InvalidParameter { name: "dt", .. })
+        Err(SimError::Input(CoreError::InvalidParameter { name: "dt", .. }))
     ));
     let mut sim = common::arms(SimOptions::default());
-    assert!(matches!(sim.set_targets(&[0.0; 3]), Err(SimError::Shape { .. })));
+    assert!(matches!(
+        sim.set_targets(&[0.0; 3]),
+        Err(SimError::Input(CoreError::Shape { .. }))
+    ));
     assert!(matches!(
         sim.set_targets(&[0.0, f64::NAN, 0.0, 0.0]),
-        Err(SimError::NonFinite { index: 1, .. })
+        Err(SimError::Input(CoreError::NonFinite { index: 1, .. }))
     ));
     assert!(matches!(
         sim.reset(&[0.0, 1.0, 0.0, 0.0]),

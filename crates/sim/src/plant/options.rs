@@ -3,6 +3,7 @@
 use crate::error::{Result, SimError, check_finite};
 use crate::pd::PdGains;
 use crate::urdf::RootMode;
+use latent_core::CoreError;
 
 /// How the world is built and stepped.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,11 +64,11 @@ impl SimOptions {
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(SimError::InvalidParameter {
+                return Err(SimError::Input(CoreError::InvalidParameter {
                     name,
                     value,
                     reason: "must be finite and > 0",
-                });
+                }));
             }
         }
         check_finite("gravity", &self.gravity)?;
@@ -77,11 +78,11 @@ impl SimOptions {
             ("contact_margin", self.contact_margin),
         ] {
             if !(value.is_finite() && value >= 0.0) {
-                return Err(SimError::InvalidParameter {
+                return Err(SimError::Input(CoreError::InvalidParameter {
                     name,
                     value,
                     reason: "must be finite and ≥ 0",
-                });
+                }));
             }
         }
         self.gains.validate("<all joints>")
