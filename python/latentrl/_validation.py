@@ -12,10 +12,7 @@ def as_matrix(
     name: str, value: Any, *, n_cols: int | None = None, min_rows: int = 1
 ) -> NDArray[np.float64]:
     """`value` as a C-ordered float64 (rows, cols) array, or a ValueError/TypeError saying why not."""
-    try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as err:
-        raise TypeError(f"{name}: expected a 2-D array of numbers, got {type(value).__name__}") from err
+    array = _floats(name, value, "a 2-D array")
     if array.ndim != 2:
         raise ValueError(f"{name}: expected a 2-D array (rows, columns), got shape {array.shape}")
     if n_cols is not None and array.shape[1] != n_cols:
@@ -30,16 +27,21 @@ def as_matrix(
 
 def as_vector(name: str, value: Any, *, length: int | None = None) -> NDArray[np.float64]:
     """`value` as a float64 1-D array (of `length` if given), or a ValueError/TypeError saying why not."""
-    try:
-        array = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as err:
-        raise TypeError(f"{name}: expected a 1-D array of numbers, got {type(value).__name__}") from err
+    array = _floats(name, value, "a 1-D array")
     if array.ndim != 1:
         raise ValueError(f"{name}: expected a 1-D array, got shape {array.shape}")
     if length is not None and array.shape[0] != length:
         raise ValueError(f"{name}: expected shape ({length},), got {array.shape}")
     check_finite(name, array)
     return np.ascontiguousarray(array)
+
+
+def _floats(name: str, value: Any, expected: str) -> NDArray[np.float64]:
+    """`value` as a float64 array, or a TypeError naming `name` and what was `expected`."""
+    try:
+        return np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as err:
+        raise TypeError(f"{name}: expected {expected} of numbers, got {type(value).__name__}") from err
 
 
 def check_finite(name: str, array: NDArray[np.float64]) -> None:

@@ -49,12 +49,7 @@ fn full_space_learner_improves_with_forgiving_tolerance() {
 #[test]
 fn latent_learner_improves_and_never_drops() {
     let (decoder, encoder) = common::synthetic_maps();
-    let learner = BimanualLearner::Latent {
-        decoder: &decoder,
-        encoder: &encoder,
-        low: &common::LATENT_LOW,
-        high: &common::LATENT_HIGH,
-    };
+    let learner = common::latent_learner(&decoder, &encoder);
     let plant = BimanualConfig {
         drop_tolerance: 0.005,
         ..BimanualConfig::default()

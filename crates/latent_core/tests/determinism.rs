@@ -77,12 +77,7 @@ fn full_space_one_vs_two_threads() {
 #[test]
 fn latent_one_vs_two_threads() {
     let (decoder, encoder) = common::synthetic_maps();
-    let learner = BimanualLearner::Latent {
-        decoder: &decoder,
-        encoder: &encoder,
-        low: &common::LATENT_LOW,
-        high: &common::LATENT_HIGH,
-    };
+    let learner = common::latent_learner(&decoder, &encoder);
     let a = run_on(1, &learner, &options());
     let b = run_on(2, &learner, &options());
     assert_bitwise_equal(&a, &b);

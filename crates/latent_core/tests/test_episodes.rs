@@ -7,16 +7,11 @@ mod common;
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
 use latent_core::{LearnerConfig, TrialOptions, TrialResult};
-use sim::bimanual::{BimanualConfig, BimanualLearner, run_bimanual_trials};
+use sim::bimanual::{BimanualConfig, run_bimanual_trials};
 
 fn run(options: &TrialOptions, cancel: bool) -> Vec<TrialResult> {
     let (decoder, encoder) = common::synthetic_maps();
-    let learner = BimanualLearner::Latent {
-        decoder: &decoder,
-        encoder: &encoder,
-        low: &common::LATENT_LOW,
-        high: &common::LATENT_HIGH,
-    };
+    let learner = common::latent_learner(&decoder, &encoder);
     let config = LearnerConfig {
         max_steps: 60,
         step_fraction: 0.5,

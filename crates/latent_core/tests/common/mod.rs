@@ -3,6 +3,7 @@
 
 use latent_core::{GpMap, SeKernel};
 use nalgebra::DMatrix;
+use sim::bimanual::BimanualLearner;
 
 /// Latent box of [`synthetic_maps`]: the bounding box of the training latents.
 pub const LATENT_LOW: [f64; 2] = [-0.4, -0.4];
@@ -30,4 +31,14 @@ pub fn synthetic_maps() -> (GpMap, GpMap) {
     let decoder = GpMap::new(z.clone(), x.clone(), kernel).unwrap();
     let encoder = GpMap::new(x, z, kernel).unwrap();
     (decoder, encoder)
+}
+
+/// The latent learner of Experiment 1 over [`synthetic_maps`] and their latent box.
+pub fn latent_learner<'a>(decoder: &'a GpMap, encoder: &'a GpMap) -> BimanualLearner<'a> {
+    BimanualLearner::Latent {
+        decoder,
+        encoder,
+        low: &LATENT_LOW,
+        high: &LATENT_HIGH,
+    }
 }
