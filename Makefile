@@ -13,7 +13,7 @@ help: ## list the targets
 $(VENV)/.deps: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib tqdm pytest pytest-timeout hypothesis mypy
+	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib tqdm gymnasium pytest pytest-timeout hypothesis mypy
 	touch $@
 
 $(VENV)/.built: $(VENV)/.deps Cargo.toml Cargo.lock $(shell find crates python -name '*.rs' -o -name '*.toml' -o -name '*.py' 2>/dev/null)
@@ -26,12 +26,14 @@ demo: build ## reproduce Table I and Experiment 1 (Fig. 4) on defaults into resu
 	$(PY) -m latentrl run table1 --out results/table1
 	$(PY) -m latentrl run exp1 --out results/exp1
 
-test: lint ## clippy, stub check, Rust tests (pure crates) and the default pytest run
+test: lint ## clippy, stub check, Rust tests (pure crates and the binding's panic guard) and the default pytest run
 	cargo test --quiet
+	cargo test --quiet -p latentrl_py --lib
 	$(PY) -m pytest -q
 
 test-all: lint ## everything, slow reproductions included
 	cargo test --quiet
+	cargo test --quiet -p latentrl_py --lib
 	$(PY) -m pytest -q -m ''
 
 bench: build ## criterion benches, the NumPy loop and GPy comparisons (JSON in benches/results/)

@@ -1,7 +1,14 @@
 """latentrl: reinforcement learning in the latent space of demonstrated postures."""
 
 from latentrl._base import NotFittedError
-from latentrl._native import GpMap, InvalidInputError, LatentrlError, NumericalError, __version__
+from latentrl._native import (
+    GpMap,
+    InternalError,
+    InvalidInputError,
+    LatentrlError,
+    NumericalError,
+    __version__,
+)
 from latentrl.demos import Demonstrations, load_demos, save_demos
 from latentrl.gplvm import GPLVM
 from latentrl.pca import PCA
@@ -11,6 +18,7 @@ __all__ = [
     "PCA",
     "Demonstrations",
     "GpMap",
+    "InternalError",
     "InvalidInputError",
     "LatentrlError",
     "NotFittedError",

@@ -197,7 +197,8 @@ def initial_log_theta(
     (1 where a scale is zero)."""
     variance = float(np.mean(centred**2)) or 1.0
     lengthscale_sq = float(np.median(pdist(inputs, "sqeuclidean"))) or 1.0
-    return np.log([variance, lengthscale_sq, variance / 100])
+    # Clamped at the smallest normal float: data of scale 1e-161 underflows θ3 to 0.
+    return np.log(np.maximum([variance, lengthscale_sq, variance / 100], np.finfo(np.float64).tiny))
 
 
 @dataclass(frozen=True)

@@ -9,9 +9,11 @@ from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "GpMap",
+    "InternalError",
     "InvalidInputError",
     "LatentrlError",
     "NumericalError",
+    "Sim",
     "__version__",
     "arms_elbows",
     "arms_fk",
@@ -29,6 +31,9 @@ class LatentrlError(ValueError):
 
 class InvalidInputError(LatentrlError):
     """An argument had the wrong shape, a non-finite value or an impossible value."""
+
+class InternalError(LatentrlError):
+    """A bug in latentrl's Rust core (a caught panic); please report it with the message."""
 
 class NumericalError(LatentrlError):
     """A computation could not be carried out stably
@@ -62,6 +67,61 @@ class GpMap:
     @property
     def theta(self) -> list[float]:
         """(θ1, θ2, θ3)."""
+
+@final
+class Sim:
+    """A URDF robot in a rapier3d world, every actuated joint PD-servoed to its target."""
+
+    def __new__(
+        cls,
+        urdf: str | PathLike[str],
+        *,
+        root: Literal["fixed", "floating"] = "fixed",
+        dt: float = ...,
+        substeps: int = 12,
+        solver_iterations: int = 4,
+        kp: float = 5000.0,
+        kd: float = 50.0,
+        max_force: float = ...,
+        gravity: NDArray[np.float64] | None = None,
+    ) -> Sim:
+        """Builds the world from `urdf`: a path, or the URDF XML itself (a str starting
+        with `<`)."""
+    @property
+    def joint_names(self) -> list[str]:
+        """Names of the actuated joints, in the order of postures and targets."""
+    @property
+    def dt(self) -> float:
+        """Duration of one RL step, `dt · substeps` (s)."""
+    @property
+    def time(self) -> float:
+        """Simulated time since the last reset (s)."""
+    def reset(self, posture: NDArray[np.float64]) -> None:
+        """Teleports the robot to `posture` (num_joints,) at rest and aims the servos at it."""
+    def set_targets(self, targets: NDArray[np.float64]) -> None:
+        """Sets every servo target (num_joints,), clamped to the joint limits."""
+    def targets(self) -> NDArray[np.float64]:
+        """The servo targets after clamping (num_joints,)."""
+    def step(self, n: int | None = None) -> None:
+        """Advances `n` physics steps of `dt`, or one RL step when `n` is None."""
+    def joint_positions(self) -> NDArray[np.float64]:
+        """The joint positions (num_joints,): the reached posture."""
+    def joint_velocities(self) -> NDArray[np.float64]:
+        """The joint velocities (num_joints,)."""
+    def frame_position(self, link: str) -> NDArray[np.float64]:
+        """World position (3,) of link `link`'s frame (e.g. a hand)."""
+    def add_box_obstacle(
+        self,
+        center: NDArray[np.float64],
+        half_extents: NDArray[np.float64],
+        *,
+        sensor: bool = True,
+        name: str = "box",
+    ) -> int:
+        """Adds a static axis-aligned box at `center` (3,) with `half_extents` (3,); returns its
+        id. A sensor (default) is passed through but still reported by `contacts`."""
+    def contacts(self) -> list[tuple[str, int]]:
+        """Every (link name, obstacle id) pair whose shapes are within the contact margin."""
 
 def gplvm_nll_grad(
     latent: NDArray[np.float64], data: NDArray[np.float64], log_theta: NDArray[np.float64]

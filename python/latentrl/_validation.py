@@ -37,7 +37,10 @@ def as_vector(name: str, value: Any, *, length: int | None = None) -> NDArray[np
 
 
 def _floats(name: str, value: Any, expected: str) -> NDArray[np.float64]:
-    """`value` as a float64 array, or a TypeError naming `name` and what was `expected`."""
+    """`value` as a float64 array, or a TypeError naming `name` and what was `expected`
+    (complex values too: casting would silently drop their imaginary parts)."""
+    if np.iscomplexobj(value):
+        raise TypeError(f"{name}: expected {expected} of real numbers, got complex values")
     try:
         return np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as err:

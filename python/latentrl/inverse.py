@@ -10,7 +10,7 @@ from scipy.optimize import minimize
 from scipy.spatial.distance import cdist
 
 from latentrl._base import initial_log_theta, minimise_nll
-from latentrl._native import GpMap
+from latentrl._native import GpMap, NumericalError
 from latentrl._reference import se_kernel
 
 Array = NDArray[np.float64]
@@ -82,7 +82,7 @@ class Projection:
         solved = cho_solve(self._factor, k_star)
         mean = self._mean + k_star @ self._alpha
         variance = self.theta[0] + self.theta[2] - k_star @ solved
-        return mean, self._alpha.T @ dk_star, float(variance), -2.0 * solved @ dk_star
+        return mean, self._alpha.T @ dk_star, np.float64(variance), -2.0 * solved @ dk_star
 
     def neg_log_density(self, z: Array, x: Array) -> tuple[float, Array]:
         """`−log N(x | μ(z), σ²(z) I)` and its gradient with respect to `z`."""
@@ -90,9 +90,8 @@ class Projection:
         residual = x - mean
         sq = residual @ residual
         value = 0.5 * len(x) * np.log(2 * np.pi * variance) + 0.5 * sq / variance
-        grad = (
-            0.5 * len(x) / variance - 0.5 * sq / variance**2
-        ) * d_variance - residual @ d_mean / variance
+        # ½D/σ² − ½sq/σ⁴ without forming σ⁴, which overflows a float for σ² > 1e154.
+        grad = (0.5 / variance) * (len(x) - sq / variance) * d_variance - residual @ d_mean / variance
         return float(value), grad
 
     def reconstruction_error(self, z: Array, x: Array) -> tuple[float, Array]:
@@ -102,10 +101,15 @@ class Projection:
         return 0.5 * float(residual @ residual), -residual @ d_mean
 
     def encode(self, X: Array) -> Array:
-        """Latent points (M, d) of postures `X` (M, D)."""
+        """Latent points (M, d) of postures `X` (M, D); NumericalError if the search overflows
+        float64 (postures of extreme scale, θ1 ≳ 1e150: found by fuzzing)."""
         starts = self.latent[cdist(X, self.postures, "sqeuclidean").argmin(axis=1)]
-        latent = [self._maximise(x, z0) for x, z0 in zip(X, starts)]
-        return np.array(latent).reshape(len(X), self.latent.shape[1])
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            latent = [self._maximise(x, z0) for x, z0 in zip(X, starts)]
+        result = np.array(latent).reshape(len(X), self.latent.shape[1])
+        if not np.all(np.isfinite(result)):
+            raise NumericalError("X: the projection encoder overflowed float64; rescale the postures")
+        return result
 
     def _maximise(self, x: Array, z0: Array) -> Array:
         candidates = [z0]

@@ -66,9 +66,15 @@ class PCA(Estimator):
         """Fits the principal axes of `X` (N, D); returns self."""
         X = as_matrix("X", X)
         d = check_n_components(self.n_components, X)
+        with np.errstate(over="ignore", invalid="ignore"):
+            mean = X.mean(axis=0)
+            centred = X - mean
+            variances = (centred**2).sum(axis=0)
+        if not (np.all(np.isfinite(mean)) and np.all(np.isfinite(variances))):
+            raise ValueError("X: values too large, their variance overflows float64 (rescale X)")
         self.n_features_in_ = X.shape[1]
-        self.mean_ = X.mean(axis=0)
-        _, s, vt = np.linalg.svd(X - self.mean_, full_matrices=False)
+        self.mean_ = mean
+        _, s, vt = np.linalg.svd(centred, full_matrices=False)
         axes = vt[:d]
         self.components_ = (
             axes * np.sign(axes[np.arange(d), np.argmax(np.abs(axes), axis=1)])[:, None]

@@ -50,6 +50,12 @@ pub enum CoreError {
         /// The largest jitter tried.
         jitter: f64,
     },
+    /// A result overflowed float64 although every input was finite (inputs of extreme scale).
+    #[error("{what} is not finite although every input is: the inputs' scale overflows float64; rescale them")]
+    Overflow {
+        /// Which result.
+        what: &'static str,
+    },
     /// No admissible episode start was found.
     #[error(
         "no admissible start state in {draws} draws: every drawn start was refused by the plant \

@@ -51,6 +51,13 @@ impl GpMap {
         let centred_t = (&outputs - &mean * DMatrix::from_element(1, n, 1.0)).transpose();
         let factor = factorize(kernel.matrix(&inputs))?;
         let alpha_t = factor.cholesky.solve(&centred_t).transpose();
+        // Finite inputs of extreme scale (outputs ~1e107 over a noise ~1e-202) overflow here,
+        // and every prediction would be NaN: found by fuzzing.
+        if !mean.iter().chain(alpha_t.iter()).all(|v| v.is_finite()) {
+            return Err(CoreError::Overflow {
+                what: "the GP weights K⁻¹(outputs − mean)",
+            });
+        }
         Ok(Self {
             kernel,
             inputs,
@@ -140,6 +147,7 @@ impl GpMap {
         let mut means = DMatrix::zeros(self.output_dim(), queries.ncols());
         let mut variances = DVector::zeros(queries.ncols());
         self.for_each_query(queries, &mut means, Some(variances.as_mut_slice()));
+        check_prediction(means.as_slice())?;
         Ok((means, variances))
     }
 
@@ -148,6 +156,7 @@ impl GpMap {
         self.check_queries(queries)?;
         let mut means = DMatrix::zeros(self.output_dim(), queries.ncols());
         self.for_each_query(queries, &mut means, None);
+        check_prediction(means.as_slice())?;
         Ok(means)
     }
 
@@ -165,6 +174,18 @@ impl GpMap {
                 |scratch, (j, mean_out)| self.mean_into(queries.column(j).as_slice(), mean_out, scratch),
             ),
         }
+    }
+}
+
+/// [`CoreError::Overflow`] if a predicted mean is not finite: finite queries of a map fitted
+/// at an extreme scale (θ1 ~1e303 over outputs ~1e230) can overflow `k*ᵀα`; found by fuzzing.
+pub fn check_prediction(means: &[f64]) -> Result<()> {
+    if means.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(CoreError::Overflow {
+            what: "the GP predictive mean",
+        })
     }
 }
 
@@ -234,5 +255,19 @@ mod tests {
         ));
         let nan = DMatrix::from_element(2, 1, f64::NAN);
         assert!(matches!(gp.predict(&nan), Err(CoreError::NonFinite { .. })));
+    }
+
+    /// Fuzzing found outputs ~1e107 with θ ~1e-202 giving NaN predictions.
+    #[test]
+    fn overflowing_weights_are_an_error_not_nan() {
+        let gp = toy();
+        let kernel = SeKernel::new([1e-202; 3]).unwrap();
+        let fitted = GpMap::new(gp.inputs.clone(), gp.inputs.map(|v| v * 1e107), kernel);
+        assert!(matches!(fitted, Err(CoreError::Overflow { .. })));
+        assert!(check_prediction(&[1.0, -2.0]).is_ok());
+        assert!(matches!(
+            check_prediction(&[1.0, f64::NAN]),
+            Err(CoreError::Overflow { .. })
+        ));
     }
 }

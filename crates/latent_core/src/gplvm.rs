@@ -80,6 +80,12 @@ pub fn nll_grad(latent: &DMatrix<f64>, centred: &DMatrix<f64>, log_theta: [f64; 
         grad_log_theta[0] += g[(i, i)] * kernel.variance;
     }
     grad_log_theta[2] = kernel.noise * g.trace();
+    let finite = nll.is_finite() && grad_latent.iter().chain(&grad_log_theta).all(|v| v.is_finite());
+    if !finite {
+        return Err(CoreError::Overflow {
+            what: "the GPLVM objective or its gradient",
+        });
+    }
     Ok(NllGrad {
         nll,
         grad_latent,
@@ -162,5 +168,14 @@ mod tests {
             nll_grad(&latent, &data, [0.0, f64::NAN, 0.0]),
             Err(CoreError::NonFinite { .. })
         ));
+    }
+
+    /// Fuzzing found data of scale 1e200 giving an infinite NLL and NaN gradients.
+    #[test]
+    fn overflowing_scale_is_an_error_not_nan() {
+        let (latent, data, lt) = problem();
+        let huge = &data * 1e200;
+        assert!(matches!(nll_grad(&latent, &huge, lt), Err(CoreError::Overflow { .. })));
+        assert!(nll_grad(&latent, &(&data * 1e100), lt).is_ok());
     }
 }

@@ -10,7 +10,7 @@ use latent_core::{LearnerConfig, Plant};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{sim_to_py, to_py};
+use crate::errors::{guard, sim_to_py, to_py};
 use crate::rl::{
     RunArgs, apply_config_dict, echo_learner, float, floats, gp_map, int_in, invalid, latent_args, pack_results,
     run_with_polling, type_name,
@@ -190,35 +190,37 @@ pub fn run_arms_trials<'py>(
     return_weights: bool,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    #[rustfmt::skip]
-    let run = RunArgs { n_trials, episodes, base_seed, first_trial, config, record_episodes, test_episodes,
-                        record_test_episodes, return_weights, progress }.check()?;
-    let (plant, learner_config) = apply_config(run.config.as_ref())?;
-    let (decoder, encoder) = (Some(decoder), Some(encoder));
-    let latent = latent_args(
-        gp_map("decoder", &decoder)?,
-        gp_map("encoder", &encoder)?,
-        Some(latent_low),
-        Some(latent_high),
-        "for the arms",
-    )?;
-    let model = urdf_model(urdf)?;
-    // Builds one plant and the learner before any thread starts: bad links, limits or
-    // dimensions fail here with the plant's own message.
-    let probe = ArmsPlant::new(model.clone(), plant.clone()).map_err(sim_to_py)?;
-    let arms_latent = ArmsLatent {
-        decoder: latent.decoder,
-        encoder: latent.encoder,
-        low: &latent.low,
-        high: &latent.high,
-    };
-    let (template, _) = arms_latent.build(&learner_config, probe.posture_dim()).map_err(to_py)?;
-    drop(probe);
-    let options = &run.options;
-    let results = run_with_polling(py, options, run.progress.as_ref(), |cancel, done| {
-        run_core(&model, &plant, &learner_config, &arms_latent, options, cancel, done)
-    })?;
-    let out = pack_results(py, &results, &template, options, 4)?;
-    out.set_item("config", echo_config(py, &plant, &learner_config)?)?;
-    Ok(out)
+    guard(|| {
+        #[rustfmt::skip]
+        let run = RunArgs { n_trials, episodes, base_seed, first_trial, config, record_episodes, test_episodes,
+                            record_test_episodes, return_weights, progress }.check()?;
+        let (plant, learner_config) = apply_config(run.config.as_ref())?;
+        let (decoder, encoder) = (Some(decoder), Some(encoder));
+        let latent = latent_args(
+            gp_map("decoder", &decoder)?,
+            gp_map("encoder", &encoder)?,
+            Some(latent_low),
+            Some(latent_high),
+            "for the arms",
+        )?;
+        let model = urdf_model(urdf)?;
+        // Builds one plant and the learner before any thread starts: bad links, limits or
+        // dimensions fail here with the plant's own message.
+        let probe = ArmsPlant::new(model.clone(), plant.clone()).map_err(sim_to_py)?;
+        let arms_latent = ArmsLatent {
+            decoder: latent.decoder,
+            encoder: latent.encoder,
+            low: &latent.low,
+            high: &latent.high,
+        };
+        let (template, _) = arms_latent.build(&learner_config, probe.posture_dim()).map_err(to_py)?;
+        drop(probe);
+        let options = &run.options;
+        let results = run_with_polling(py, options, run.progress.as_ref(), |cancel, done| {
+            run_core(&model, &plant, &learner_config, &arms_latent, options, cancel, done)
+        })?;
+        let out = pack_results(py, &results, &template, options, 4)?;
+        out.set_item("config", echo_config(py, &plant, &learner_config)?)?;
+        Ok(out)
+    })
 }

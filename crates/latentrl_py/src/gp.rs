@@ -5,7 +5,7 @@ use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{fixed, points, to_points, to_vector};
-use crate::errors::{InvalidInputError, to_py};
+use crate::errors::{InvalidInputError, guard, to_py};
 
 /// Means (M, p) and variances (M,) as NumPy arrays.
 type MeansVariances<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
@@ -30,18 +30,22 @@ impl PyGpMap {
         outputs: PyReadonlyArray2<'_, f64>,
         theta: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Self> {
-        let inputs = points("inputs", &inputs)?;
-        let outputs = points("outputs", &outputs)?;
-        let kernel = SeKernel::new(fixed::<3>("theta", &theta)?).map_err(to_py)?;
-        let inner = py.detach(|| GpMap::new(inputs, outputs, kernel)).map_err(to_py)?;
-        Ok(Self { inner })
+        guard(|| {
+            let inputs = points("inputs", &inputs)?;
+            let outputs = points("outputs", &outputs)?;
+            let kernel = SeKernel::new(fixed::<3>("theta", &theta)?).map_err(to_py)?;
+            let inner = py.detach(|| GpMap::new(inputs, outputs, kernel)).map_err(to_py)?;
+            Ok(Self { inner })
+        })
     }
 
     /// Means (M, p) and variances (M,) at `queries` (M, q).
     fn predict<'py>(&self, py: Python<'py>, queries: PyReadonlyArray2<'py, f64>) -> PyResult<MeansVariances<'py>> {
-        let queries = points("queries", &queries)?;
-        let (means, variances) = py.detach(|| self.inner.predict(&queries)).map_err(to_py)?;
-        Ok((to_points(py, means)?, to_vector(py, variances)))
+        guard(|| {
+            let queries = points("queries", &queries)?;
+            let (means, variances) = py.detach(|| self.inner.predict(&queries)).map_err(to_py)?;
+            Ok((to_points(py, means)?, to_vector(py, variances)))
+        })
     }
 
     /// Means only (M, p) at `queries` (M, q): no variance, several times faster.
@@ -50,9 +54,11 @@ impl PyGpMap {
         py: Python<'py>,
         queries: PyReadonlyArray2<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let queries = points("queries", &queries)?;
-        let means = py.detach(|| self.inner.predict_mean(&queries)).map_err(to_py)?;
-        to_points(py, means)
+        guard(|| {
+            let queries = points("queries", &queries)?;
+            let means = py.detach(|| self.inner.predict_mean(&queries)).map_err(to_py)?;
+            to_points(py, means)
+        })
     }
 
     /// Mean (p,) and variance at one point `x` (q,).
@@ -61,42 +67,45 @@ impl PyGpMap {
         py: Python<'py>,
         x: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
-        let x: Vec<f64> = x.as_array().iter().copied().collect();
-        if x.len() != self.inner.input_dim() {
-            return Err(InvalidInputError::new_err(format!(
-                "x: expected shape ({},), got ({},)",
-                self.inner.input_dim(),
-                x.len()
-            )));
-        }
-        latent_core::error::check_finite("x", &x).map_err(to_py)?;
-        let mut mean = vec![0.0; self.inner.output_dim()];
-        let variance = self.inner.predict_into(&x, &mut mean, &mut self.inner.scratch());
-        Ok((PyArray1::from_vec(py, mean), variance))
+        guard(|| {
+            let x: Vec<f64> = x.as_array().iter().copied().collect();
+            if x.len() != self.inner.input_dim() {
+                return Err(InvalidInputError::new_err(format!(
+                    "x: expected shape ({},), got ({},)",
+                    self.inner.input_dim(),
+                    x.len()
+                )));
+            }
+            latent_core::error::check_finite("x", &x).map_err(to_py)?;
+            let mut mean = vec![0.0; self.inner.output_dim()];
+            let variance = self.inner.predict_into(&x, &mut mean, &mut self.inner.scratch());
+            latent_core::gp::check_prediction(&mean).map_err(to_py)?;
+            Ok((PyArray1::from_vec(py, mean), variance))
+        })
     }
 
     /// Input dimension q.
     #[getter]
-    fn input_dim(&self) -> usize {
-        self.inner.input_dim()
+    fn input_dim(&self) -> PyResult<usize> {
+        guard(|| Ok(self.inner.input_dim()))
     }
 
     /// Output dimension p.
     #[getter]
-    fn output_dim(&self) -> usize {
-        self.inner.output_dim()
+    fn output_dim(&self) -> PyResult<usize> {
+        guard(|| Ok(self.inner.output_dim()))
     }
 
     /// Jitter added to the kernel matrix's diagonal to factorise it (0.0 if none).
     #[getter]
-    fn jitter(&self) -> f64 {
-        self.inner.jitter()
+    fn jitter(&self) -> PyResult<f64> {
+        guard(|| Ok(self.inner.jitter()))
     }
 
     /// (θ1, θ2, θ3).
     #[getter]
-    fn theta(&self) -> [f64; 3] {
-        self.inner.kernel().theta()
+    fn theta(&self) -> PyResult<[f64; 3]> {
+        guard(|| Ok(self.inner.kernel().theta()))
     }
 }
 
@@ -109,14 +118,16 @@ pub fn gplvm_nll_grad<'py>(
     data: PyReadonlyArray2<'py, f64>,
     log_theta: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<NllGradient<'py>> {
-    let latent = points("latent", &latent)?;
-    let data = points("data", &data)?;
-    let log_theta = fixed::<3>("log_theta", &log_theta)?;
-    let r = py.detach(|| nll_grad(&latent, &data, log_theta)).map_err(to_py)?;
-    Ok((
-        r.nll,
-        to_points(py, r.grad_latent)?,
-        PyArray1::from_vec(py, r.grad_log_theta.to_vec()),
-        r.jitter,
-    ))
+    guard(|| {
+        let latent = points("latent", &latent)?;
+        let data = points("data", &data)?;
+        let log_theta = fixed::<3>("log_theta", &log_theta)?;
+        let r = py.detach(|| nll_grad(&latent, &data, log_theta)).map_err(to_py)?;
+        Ok((
+            r.nll,
+            to_points(py, r.grad_latent)?,
+            PyArray1::from_vec(py, r.grad_log_theta.to_vec()),
+            r.jitter,
+        ))
+    })
 }

@@ -7,7 +7,7 @@ use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{points, to_points};
-use crate::errors::{InvalidInputError, sim_to_py};
+use crate::errors::{InvalidInputError, guard, sim_to_py};
 
 /// Columns of the returned table, one row per target.
 const COLUMNS: usize = 6;
@@ -35,49 +35,51 @@ pub fn humanoid_fall_check<'py>(
     solver_iterations: usize,
     grip_width: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let start: Vec<f64> = start.as_array().iter().copied().collect();
-    let targets = points("targets", &targets)?;
-    if targets.nrows() != start.len() {
-        return Err(InvalidInputError::new_err(format!(
-            "targets: expected shape (M, {}), got ({}, {})",
-            start.len(),
-            targets.ncols(),
-            targets.nrows()
-        )));
-    }
-    let rows: Vec<Vec<f64>> = targets.column_iter().map(|c| c.iter().copied().collect()).collect();
-    let gains = PdGains::new(kp, kd, max_force).map_err(sim_to_py)?;
-    let options = SimOptions {
-        root: RootMode::Floating,
-        ground: Some(0.0),
-        gains,
-        dt,
-        solver_iterations,
-        ..SimOptions::default()
-    };
-    let config = FallCheckConfig {
-        hold,
-        grip_width,
-        ..FallCheckConfig::default()
-    };
-    let path = urdf_path.to_string();
-    let reports = py
-        .detach(|| {
-            let mut sim = PhysicsSim::from_urdf_file(&path, options)?;
-            run_fall_check(&mut sim, &start, &rows, &config)
-        })
-        .map_err(sim_to_py)?;
-    let mut out = DMatrix::zeros(COLUMNS, reports.len());
-    for (j, r) in reports.iter().enumerate() {
-        let row = [
-            f64::from(u8::from(r.fell)),
-            r.min_margin,
-            r.final_margin,
-            r.grip_error,
-            r.max_grip_error,
-            r.status.base_height,
-        ];
-        out.column_mut(j).copy_from_slice(&row);
-    }
-    to_points(py, out)
+    guard(|| {
+        let start: Vec<f64> = start.as_array().iter().copied().collect();
+        let targets = points("targets", &targets)?;
+        if targets.nrows() != start.len() {
+            return Err(InvalidInputError::new_err(format!(
+                "targets: expected shape (M, {}), got ({}, {})",
+                start.len(),
+                targets.ncols(),
+                targets.nrows()
+            )));
+        }
+        let rows: Vec<Vec<f64>> = targets.column_iter().map(|c| c.iter().copied().collect()).collect();
+        let gains = PdGains::new(kp, kd, max_force).map_err(sim_to_py)?;
+        let options = SimOptions {
+            root: RootMode::Floating,
+            ground: Some(0.0),
+            gains,
+            dt,
+            solver_iterations,
+            ..SimOptions::default()
+        };
+        let config = FallCheckConfig {
+            hold,
+            grip_width,
+            ..FallCheckConfig::default()
+        };
+        let path = urdf_path.to_string();
+        let reports = py
+            .detach(|| {
+                let mut sim = PhysicsSim::from_urdf_file(&path, options)?;
+                run_fall_check(&mut sim, &start, &rows, &config)
+            })
+            .map_err(sim_to_py)?;
+        let mut out = DMatrix::zeros(COLUMNS, reports.len());
+        for (j, r) in reports.iter().enumerate() {
+            let row = [
+                f64::from(u8::from(r.fell)),
+                r.min_margin,
+                r.final_margin,
+                r.grip_error,
+                r.max_grip_error,
+                r.status.base_height,
+            ];
+            out.column_mut(j).copy_from_slice(&row);
+        }
+        to_points(py, out)
+    })
 }

@@ -6,6 +6,7 @@ mod convert;
 mod errors;
 mod gp;
 mod humanoid;
+mod physics;
 mod rl;
 mod sim;
 
@@ -15,6 +16,7 @@ use pyo3::prelude::*;
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     m.add_class::<gp::PyGpMap>()?;
+    m.add_class::<physics::PySim>()?;
     m.add_function(wrap_pyfunction!(gp::gplvm_nll_grad, m)?)?;
     m.add_function(wrap_pyfunction!(sim::arms_fk, m)?)?;
     m.add_function(wrap_pyfunction!(sim::arms_elbows, m)?)?;

@@ -9,11 +9,10 @@ use std::time::{Duration, Instant};
 use ::sim::bimanual::{BimanualConfig, BimanualLearner, run_bimanual_trials as run_core};
 use latent_core::{EpisodeRecord, GpMap, Learner, LearnerConfig, StartMode, TrialOptions, TrialResult};
 use numpy::{PyArray1, PyArrayMethods};
-use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{InvalidInputError, to_py};
+use crate::errors::{InvalidInputError, guard, to_py};
 use crate::gp::PyGpMap;
 
 /// How often the calling thread wakes to check Ctrl-C and report progress.
@@ -464,53 +463,55 @@ pub fn run_bimanual_trials<'py>(
     return_weights: bool,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let name: String = learner.extract().map_err(|_| {
-        invalid(format!(
-            "learner: expected \"full\" or \"latent\", got {}",
-            type_name(learner)
-        ))
-    })?;
-    #[rustfmt::skip]
-    let run = RunArgs { n_trials, episodes, base_seed, first_trial, config, record_episodes, test_episodes,
-                        record_test_episodes, return_weights, progress }.check()?;
-    let (plant, learner_config) = apply_config(run.config.as_ref())?;
-    let decoder = gp_map("decoder", &decoder)?;
-    let encoder = gp_map("encoder", &encoder)?;
-    let latent;
-    let bimanual = match name.as_str() {
-        "full" => {
-            let given = |v: Option<&Bound<'py, PyAny>>| v.is_some_and(|v| !v.is_none());
-            if decoder.is_some() || encoder.is_some() || given(latent_low) || given(latent_high) {
-                return Err(invalid(
-                    "learner=\"full\" takes no decoder, encoder, latent_low or latent_high (they are for learner=\"latent\")".into(),
-                ));
+    guard(|| {
+        let name: String = learner.extract().map_err(|_| {
+            invalid(format!(
+                "learner: expected \"full\" or \"latent\", got {}",
+                type_name(learner)
+            ))
+        })?;
+        #[rustfmt::skip]
+        let run = RunArgs { n_trials, episodes, base_seed, first_trial, config, record_episodes, test_episodes,
+                            record_test_episodes, return_weights, progress }.check()?;
+        let (plant, learner_config) = apply_config(run.config.as_ref())?;
+        let decoder = gp_map("decoder", &decoder)?;
+        let encoder = gp_map("encoder", &encoder)?;
+        let latent;
+        let bimanual = match name.as_str() {
+            "full" => {
+                let given = |v: Option<&Bound<'py, PyAny>>| v.is_some_and(|v| !v.is_none());
+                if decoder.is_some() || encoder.is_some() || given(latent_low) || given(latent_high) {
+                    return Err(invalid(
+                        "learner=\"full\" takes no decoder, encoder, latent_low or latent_high (they are for learner=\"latent\")".into(),
+                    ));
+                }
+                BimanualLearner::Full
             }
-            BimanualLearner::Full
-        }
-        "latent" => {
-            latent = latent_args(decoder, encoder, latent_low, latent_high, "for learner=\"latent\"")?;
-            BimanualLearner::Latent {
-                decoder: latent.decoder,
-                encoder: latent.encoder,
-                low: &latent.low,
-                high: &latent.high,
+            "latent" => {
+                latent = latent_args(decoder, encoder, latent_low, latent_high, "for learner=\"latent\"")?;
+                BimanualLearner::Latent {
+                    decoder: latent.decoder,
+                    encoder: latent.encoder,
+                    low: &latent.low,
+                    high: &latent.high,
+                }
             }
-        }
-        other => {
-            return Err(invalid(format!(
-                "learner: expected \"full\" or \"latent\", got {other:?}"
-            )));
-        }
-    };
-    // Validates the learner (grid size, dimensions) before any thread starts.
-    let (template, _) = bimanual.build(&plant, &learner_config).map_err(to_py)?;
-    let options = &run.options;
-    let results = run_with_polling(py, options, run.progress.as_ref(), |cancel, done| {
-        run_core(&plant, &learner_config, &bimanual, options, cancel, done)
-    })?;
-    let out = pack_results(py, &results, &template, options, 4)?;
-    out.set_item("config", echo_config(py, &plant, &learner_config)?)?;
-    Ok(out)
+            other => {
+                return Err(invalid(format!(
+                    "learner: expected \"full\" or \"latent\", got {other:?}"
+                )));
+            }
+        };
+        // Validates the learner (grid size, dimensions) before any thread starts.
+        let (template, _) = bimanual.build(&plant, &learner_config).map_err(to_py)?;
+        let options = &run.options;
+        let results = run_with_polling(py, options, run.progress.as_ref(), |cancel, done| {
+            run_core(&plant, &learner_config, &bimanual, options, cancel, done)
+        })?;
+        let out = pack_results(py, &results, &template, options, 4)?;
+        out.set_item("config", echo_config(py, &plant, &learner_config)?)?;
+        Ok(out)
+    })
 }
 
 /// Runs `run(cancel, done)` (the trials) on a worker thread; this thread wakes every
@@ -527,14 +528,10 @@ where
 {
     let cancel = AtomicBool::new(false);
     let done = AtomicUsize::new(0);
-    let worker_done = AtomicBool::new(false);
     let total = options.n_trials * (options.episodes + options.test_episodes);
     std::thread::scope(|scope| {
-        let worker = scope.spawn(|| {
-            let r = run(&cancel, &done);
-            worker_done.store(true, Ordering::Release);
-            r
-        });
+        // Finished also when it panics (a flag set after `run` would never be set).
+        let worker = scope.spawn(|| run(&cancel, &done));
         let stop = |err: PyErr| {
             cancel.store(true, Ordering::Relaxed);
             err
@@ -543,10 +540,10 @@ where
         loop {
             let finished = py.detach(|| {
                 let deadline = Instant::now() + POLL;
-                while !worker_done.load(Ordering::Acquire) && Instant::now() < deadline {
+                while !worker.is_finished() && Instant::now() < deadline {
                     std::thread::sleep(Duration::from_millis(2));
                 }
-                worker_done.load(Ordering::Acquire)
+                worker.is_finished()
             });
             if finished {
                 break;
@@ -567,8 +564,10 @@ where
         if let Some(e) = failure {
             return Err(e);
         }
+        // A panic in the worker (or a rayon thread under it) goes on unwinding here, for the
+        // exported function's `guard` to raise as InternalError.
         let results = joined
-            .map_err(|_| PyRuntimeError::new_err("internal error: the trial worker panicked"))?
+            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
             .map_err(to_py)?;
         if let Some(cb) = progress {
             cb.call1((done.load(Ordering::Relaxed), total))?;

@@ -6,7 +6,7 @@ use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{points, to_points};
-use crate::errors::{InvalidInputError, sim_to_py};
+use crate::errors::{InvalidInputError, guard, sim_to_py};
 
 /// `(N, 4)` array → flat row-major values, or InvalidInputError naming `name`.
 fn rows4(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<DMatrix<f64>> {
@@ -25,33 +25,39 @@ fn rows4(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<DMatrix<f64>
 /// (default geometry: shoulders (±0.15, 0), links 0.3 + 0.3 m).
 #[pyfunction]
 pub fn arms_fk<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let postures = rows4("postures", &postures)?;
-    let n = postures.ncols();
-    let hands = py
-        .detach(|| PlanarArms::default().forward_batch(postures.as_slice()))
-        .map_err(sim_to_py)?;
-    to_points(py, DMatrix::from_vec(4, n, hands))
+    guard(|| {
+        let postures = rows4("postures", &postures)?;
+        let n = postures.ncols();
+        let hands = py
+            .detach(|| PlanarArms::default().forward_batch(postures.as_slice()))
+            .map_err(sim_to_py)?;
+        to_points(py, DMatrix::from_vec(4, n, hands))
+    })
 }
 
 /// Elbows `(N, 4)` `[x_L, y_L, x_R, y_R]` of postures `(N, 4)` (for drawing).
 #[pyfunction]
 pub fn arms_elbows<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let postures = rows4("postures", &postures)?;
-    let n = postures.ncols();
-    let elbows = py
-        .detach(|| PlanarArms::default().elbows_batch(postures.as_slice()))
-        .map_err(sim_to_py)?;
-    to_points(py, DMatrix::from_vec(4, n, elbows))
+    guard(|| {
+        let postures = rows4("postures", &postures)?;
+        let n = postures.ncols();
+        let elbows = py
+            .detach(|| PlanarArms::default().elbows_batch(postures.as_slice()))
+            .map_err(sim_to_py)?;
+        to_points(py, DMatrix::from_vec(4, n, elbows))
+    })
 }
 
 /// Postures `(N, 4)` (elbows outward, shoulder angles continuous in front of the body) that
 /// put the hands at `hands` `(N, 4)`; an unreachable row raises InvalidInputError.
 #[pyfunction]
 pub fn arms_ik<'py>(py: Python<'py>, hands: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let hands = rows4("hands", &hands)?;
-    let n = hands.ncols();
-    let postures = py
-        .detach(|| PlanarArms::default().inverse_batch(hands.as_slice()))
-        .map_err(sim_to_py)?;
-    to_points(py, DMatrix::from_vec(4, n, postures))
+    guard(|| {
+        let hands = rows4("hands", &hands)?;
+        let n = hands.ncols();
+        let postures = py
+            .detach(|| PlanarArms::default().inverse_batch(hands.as_slice()))
+            .map_err(sim_to_py)?;
+        to_points(py, DMatrix::from_vec(4, n, postures))
+    })
 }

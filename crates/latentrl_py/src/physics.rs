@@ -1,0 +1,203 @@
+//! Binding of `sim::plant`: a URDF robot in a rapier3d world with PD servos ([`PhysicsSim`]),
+//! driven from Python one RL step (or `n` physics steps) per call.
+
+use std::path::PathBuf;
+
+use ::sim::{Obstacle, ObstacleShape, PdGains, PhysicsSim, RootMode, SimOptions, UrdfModel};
+use nalgebra::Isometry3;
+use numpy::{PyArray1, PyReadonlyArray1};
+use pyo3::prelude::*;
+
+use crate::convert::fixed;
+use crate::errors::{InvalidInputError, guard, sim_to_py};
+
+/// A 1-D array of any length, copied into a `Vec` (the sim checks the length).
+fn vector(array: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
+    array.as_array().iter().copied().collect()
+}
+
+/// A URDF robot in a rapier3d world, every actuated joint PD-servoed to its target.
+#[pyclass(name = "Sim", module = "latentrl._native")]
+pub struct PySim {
+    inner: PhysicsSim,
+}
+
+#[pymethods]
+impl PySim {
+    /// Builds the world from `urdf`: a path, or the URDF XML itself (a str starting with `<`).
+    #[new]
+    #[pyo3(signature = (
+        urdf, *, root = "fixed", dt = 1.0 / 240.0, substeps = 12, solver_iterations = 4,
+        kp = 5000.0, kd = 50.0, max_force = f64::INFINITY, gravity = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        urdf: &Bound<'_, PyAny>,
+        root: &str,
+        dt: f64,
+        substeps: i64,
+        solver_iterations: i64,
+        kp: f64,
+        kd: f64,
+        max_force: f64,
+        gravity: Option<PyReadonlyArray1<'_, f64>>,
+    ) -> PyResult<Self> {
+        guard(|| {
+            let root = match root {
+                "fixed" => RootMode::Fixed,
+                "floating" => RootMode::Floating,
+                other => {
+                    return Err(InvalidInputError::new_err(format!(
+                        "root: expected \"fixed\" or \"floating\", got {other:?}"
+                    )));
+                }
+            };
+            let count = |name: &str, value: i64| {
+                usize::try_from(value)
+                    .ok()
+                    .filter(|&v| v > 0)
+                    .ok_or_else(|| InvalidInputError::new_err(format!("{name}: expected an int > 0, got {value}")))
+            };
+            let mut options = SimOptions {
+                root,
+                dt,
+                substeps: count("substeps", substeps)?,
+                solver_iterations: count("solver_iterations", solver_iterations)?,
+                gains: PdGains::new(kp, kd, max_force).map_err(sim_to_py)?,
+                ..SimOptions::default()
+            };
+            if let Some(g) = gravity {
+                options.gravity = fixed::<3>("gravity", &g)?;
+            }
+            let model = match urdf.extract::<String>() {
+                Ok(text) if text.trim_start().starts_with('<') => UrdfModel::parse(&text),
+                _ => {
+                    let path: PathBuf = urdf
+                        .extract()
+                        .map_err(|_| InvalidInputError::new_err("urdf: expected a path or the URDF XML as a str"))?;
+                    py.detach(|| UrdfModel::from_file(path))
+                }
+            }
+            .map_err(sim_to_py)?;
+            let inner = py.detach(|| PhysicsSim::new(model, options)).map_err(sim_to_py)?;
+            Ok(Self { inner })
+        })
+    }
+
+    /// Names of the actuated joints, in the order of postures and targets.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.inner
+            .model()
+            .joint_names()
+            .into_iter()
+            .map(str::to_string)
+            .collect()
+    }
+
+    /// Duration of one RL step, `dt · substeps` (s).
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.inner.rl_dt()
+    }
+
+    /// Simulated time since the last reset (s).
+    #[getter]
+    fn time(&self) -> f64 {
+        self.inner.time()
+    }
+
+    /// Teleports the robot to `posture` (num_joints,) at rest and aims the servos at it.
+    fn reset(&mut self, posture: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        guard(|| self.inner.reset(&vector(&posture)).map_err(sim_to_py))
+    }
+
+    /// Sets every servo target (num_joints,), clamped to the joint limits.
+    fn set_targets(&mut self, targets: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        guard(|| self.inner.set_targets(&vector(&targets)).map_err(sim_to_py))
+    }
+
+    /// The servo targets after clamping (num_joints,).
+    fn targets<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.targets().to_vec())
+    }
+
+    /// Advances `n` physics steps of `dt`, or one RL step (`substeps` of them) when `n` is None.
+    #[pyo3(signature = (n = None))]
+    fn step(&mut self, py: Python<'_>, n: Option<i64>) -> PyResult<()> {
+        let steps = match n {
+            None => self.inner.options().substeps,
+            Some(n) => usize::try_from(n)
+                .map_err(|_| InvalidInputError::new_err(format!("n: expected an int >= 0 or None, got {n}")))?,
+        };
+        let inner = &mut self.inner;
+        guard(|| {
+            py.detach(|| inner.step(steps));
+            Ok(())
+        })
+    }
+
+    /// The joint positions (num_joints,): the reached posture.
+    fn joint_positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.joint_positions())
+    }
+
+    /// The joint velocities (num_joints,).
+    fn joint_velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.joint_velocities())
+    }
+
+    /// World position (3,) of link `link`'s frame (e.g. a hand).
+    fn frame_position<'py>(&self, py: Python<'py>, link: &str) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        guard(|| {
+            let frame = self.inner.frame(link, [0.0; 3]).map_err(sim_to_py)?;
+            Ok(PyArray1::from_vec(py, self.inner.frame_position(&frame).to_vec()))
+        })
+    }
+
+    /// Adds a static axis-aligned box at `center` (3,) with `half_extents` (3,); returns its id.
+    /// A sensor (default) is passed through but still reported by `contacts`.
+    #[pyo3(signature = (center, half_extents, *, sensor = true, name = "box"))]
+    fn add_box_obstacle(
+        &mut self,
+        center: PyReadonlyArray1<'_, f64>,
+        half_extents: PyReadonlyArray1<'_, f64>,
+        sensor: bool,
+        name: &str,
+    ) -> PyResult<usize> {
+        guard(|| {
+            let [x, y, z] = fixed::<3>("center", &center)?;
+            let obstacle = Obstacle {
+                name: name.to_string(),
+                shape: ObstacleShape::Box {
+                    half_extents: fixed::<3>("half_extents", &half_extents)?,
+                },
+                pose: Isometry3::translation(x, y, z),
+                sensor,
+            };
+            self.inner.add_obstacle(obstacle).map_err(sim_to_py)
+        })
+    }
+
+    /// Every (link name, obstacle id) pair whose shapes are within the contact margin.
+    fn contacts(&self) -> PyResult<Vec<(String, usize)>> {
+        guard(|| {
+            Ok(self
+                .inner
+                .contacts()
+                .into_iter()
+                .map(|c| (c.link, c.obstacle))
+                .collect())
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Sim(robot={:?}, joints={}, dt={})",
+            self.inner.model().name(),
+            self.inner.num_joints(),
+            self.inner.rl_dt()
+        )
+    }
+}

@@ -1,0 +1,422 @@
+"""Gymnasium environments of the paper's tasks, registered on import of `latentrl.envs`.
+
+- `latentrl/BimanualReach-v0`: Experiment 1's kinematic toy (SPEC §4.1), in NumPy.
+- `latentrl/TwoArms-v0`: Experiment 2's two planar arms (SPEC §4.2), simulated by the Rust
+  `Sim` (rapier3d, PD servos).
+- `LatentSpaceWrapper`: observations and actions in the latent space of a fitted `PCA` or
+  `GPLVM` (SPEC §3.1): an action is a latent delta, the target latent point is decoded to a
+  posture target, and the reached posture is encoded back.
+
+Both environments expose `posture` (the current posture, (4,)) so the wrapper can encode it;
+an action is a posture delta, clipped to the action space, added to the current posture.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from typing import Any, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from numpy.typing import NDArray
+
+from latentrl import _native
+from latentrl.datasets import OFFSET, arms_forward
+
+__all__ = ["BimanualReachEnv", "LatentSpaceWrapper", "TwoArmsEnv"]
+
+Obs = NDArray[np.float64]
+
+
+def _canvas(size: int = 400) -> tuple[Any, Any]:
+    """A matplotlib Figure on an Agg canvas (no pyplot, no display) and its axes."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(size / 100, size / 100), dpi=100)
+    FigureCanvasAgg(fig)
+    return fig, fig.add_subplot(aspect="equal")
+
+
+def _pixels(fig: Any) -> NDArray[np.uint8]:
+    fig.canvas.draw()
+    return np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
+
+
+def _posture_option(options: dict[str, Any] | None) -> Obs | None:
+    if not options or options.get("posture") is None:
+        return None
+    posture = np.asarray(options["posture"], dtype=np.float64)
+    if posture.shape != (4,) or not np.all(np.isfinite(posture)):
+        raise ValueError(f"options['posture']: expected 4 finite values, got {posture!r}")
+    return posture
+
+
+class BimanualReachEnv(gym.Env[Obs, Obs]):
+    """Two planar hands carrying an object to a target (paper Sec. IV-A, SPEC §4.1).
+
+    ## Description
+    The kinematic toy of Experiment 1: the state is the two hand positions and a step moves
+    them exactly to the commanded targets. The hands hold an object, so the right hand must
+    stay at the left hand + (0.1, 0); a disc obstacle lies between the start and the target.
+
+    ## Action Space
+    `Box(-max_step, max_step, (4,), float64)`: deltas of the hand targets
+    `(Δx_L, Δy_L, Δx_R, Δy_R)` in metres (clipped to the box).
+
+    ## Observation Space
+    `Box(-0.5 - max_step, 1.5 + max_step, (4,), float64)`: the hand positions
+    `(x_L, y_L, x_R, y_R)`; leaving the state box `[-0.5, 1.5]²` per hand ends the episode, so
+    the last observation may lie up to one step outside it.
+
+    ## Rewards
+    `exp(−θ ‖x − x*‖²)` with `x* = (0, 0, 0.1, 0)`, θ = 0.75 (Eq. 12); a step that ends the
+    episode earns that reward plus the penalty −1.
+
+    ## Starting State
+    Left hand ~ N((1, 1), 0.1²·I), right hand = left + (0.1, 0). `reset(options={"posture":
+    x})` starts at `x` instead.
+
+    ## Episode End
+    Terminated (with the penalty) when a coordinate leaves `[-0.5, 1.5]` (`"box_exit"`), a
+    hand enters the disc of radius 0.2 at (0.5, 0.5) (`"obstacle"`) or
+    `‖(x_R − x_L) − (0.1, 0)‖ > drop_tolerance` (`"drop"`); `info["end_reason"]` says which.
+    Truncated after 500 steps (the paper's episode length).
+
+    ## Arguments
+    `drop_tolerance` (0.1: SPEC's RL default; 0.005 the paper-strict variant), `max_step`
+    (0.05 m per coordinate), `render_mode` (`None` or `"rgb_array"`).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+    target = np.array([0.0, 0.0, 0.1, 0.0])
+    theta = 0.75
+    penalty = -1.0
+    box = (-0.5, 1.5)
+    obstacle_centre = np.array([0.5, 0.5])
+    obstacle_radius = 0.2
+    dt = 0.05
+    """One RL step (s): the paper's δt; the toy has no physics sub-steps."""
+
+    def __init__(
+        self,
+        drop_tolerance: float = 0.1,
+        max_step: float = 0.05,
+        render_mode: str | None = None,
+    ) -> None:
+        if not (np.isfinite(drop_tolerance) and drop_tolerance > 0):
+            raise ValueError(f"drop_tolerance must be finite and > 0, got {drop_tolerance!r}")
+        if not (np.isfinite(max_step) and max_step > 0):
+            raise ValueError(f"max_step must be finite and > 0, got {max_step!r}")
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        self.drop_tolerance = float(drop_tolerance)
+        self.max_step = float(max_step)
+        self.render_mode = render_mode
+        self.action_space = spaces.Box(-max_step, max_step, (4,), np.float64)
+        low, high = self.box[0] - max_step, self.box[1] + max_step
+        self.observation_space = spaces.Box(low, high, (4,), np.float64)
+        self.posture = np.zeros(4)
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Obs, dict[str, Any]]:
+        super().reset(seed=seed)
+        posture = _posture_option(options)
+        if posture is None:
+            left = self.np_random.normal([1.0, 1.0], 0.1)
+            posture = np.concatenate([left, left + OFFSET])
+        self.posture = posture
+        return self.posture.copy(), {}
+
+    def _end_reason(self, x: Obs) -> str | None:
+        if np.any(x < self.box[0]) or np.any(x > self.box[1]):
+            return "box_exit"
+        r2 = self.obstacle_radius**2
+        if any(np.sum((h - self.obstacle_centre) ** 2) < r2 for h in (x[:2], x[2:])):
+            return "obstacle"
+        if np.linalg.norm(x[2:] - x[:2] - OFFSET) > self.drop_tolerance:
+            return "drop"
+        return None
+
+    def step(self, action: Obs) -> tuple[Obs, SupportsFloat, bool, bool, dict[str, Any]]:
+        delta = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
+        self.posture = self.posture + delta
+        reward = float(np.exp(-self.theta * np.sum((self.posture - self.target) ** 2)))
+        reason = self._end_reason(self.posture)
+        if reason is not None:
+            reward += self.penalty
+        rms = float(np.sqrt(np.sum((self.posture - self.target) ** 2) / 2))
+        info = {"end_reason": reason, "reached": rms <= 0.1}
+        return self.posture.copy(), reward, reason is not None, False, info
+
+    def render(self) -> NDArray[np.uint8] | None:
+        if self.render_mode != "rgb_array":
+            return None
+        from matplotlib.patches import Circle
+
+        fig, ax = _canvas()
+        ax.set(xlim=self.box, ylim=self.box)
+        ax.add_patch(Circle(tuple(self.obstacle_centre), self.obstacle_radius, color="0.6"))
+        ax.plot(*self.target.reshape(2, 2).T, "g*", ms=10)
+        ax.plot(*self.posture.reshape(2, 2).T, "o-", color="C0", lw=3)
+        return _pixels(fig)
+
+
+WALLS = ((-1.0, 0.30, -0.36, 0.37), (-0.06, 0.30, 1.0, 0.37))
+"""The corridor of Experiment 2 (SPEC §4.2 table): walls (x_min, y_min, x_max, y_max), metres."""
+
+
+OBS_LOW = np.array([-3.6, -3.4, -3.6, -0.4, -0.76, -0.61, -0.76, -0.61])
+OBS_HIGH = np.array([6.7, 0.4, 6.7, 3.4, 0.76, 0.61, 0.76, 0.61])
+"""TwoArms observation bounds: the URDF joint limits widened by 0.1 rad; hands within the reach
+(shoulders (±0.15, 0), links 0.3 + 0.3 m) plus 1 cm."""
+
+
+def arms_urdf() -> str:
+    """Path of the shipped two-arm URDF (shoulders (±0.15, 0), links 0.3 + 0.3 m)."""
+    return str(resources.files("latentrl") / "data" / "two_arms.urdf")
+
+
+class TwoArmsEnv(gym.Env[Obs, Obs]):
+    """Two simulated planar 2-link arms holding an object (paper Sec. IV-B, SPEC §4.2).
+
+    ## Description
+    The arms of Experiment 2 in a rapier3d world (`latentrl._native.Sim`), each joint
+    PD-servoed to its target; a step sets the targets and advances one RL step (12 physics
+    steps of 1/240 s). Both hands must pass a corridor in a wall and reach a target above it
+    without breaking the grip (right hand = left hand + (0.1, 0)).
+
+    ## Action Space
+    `Box(-max_step, max_step, (4,), float64)`: deltas of the joint targets
+    `(q1_L, q2_L, q1_R, q2_R)` in radians, added to the reached posture (clipped to the box;
+    the sim clamps targets to the joint limits).
+
+    ## Observation Space
+    `Box(low, high, (8,), float64)`: the 4 joint angles (rad, within the URDF joint limits
+    widened by 0.1), then the hands `(x_L, y_L, x_R, y_R)` (m, within the arms' reach) from
+    the simulated hand frames.
+
+    ## Rewards
+    `exp(−0.35 ‖(h − h*)/0.3‖²)` with `h* = (−0.05, 0.47, 0.05, 0.47)` (Eq. 12 with a length
+    unit); a step that ends the episode earns that reward plus the penalty −1.
+
+    ## Starting State
+    Left hand uniform in (−0.25, 0.15) ± 0.03 m, right hand 0.1 m to its right, postures from
+    the analytic IK (elbows outward): below the wall. `reset(options={"posture": q})` starts
+    at the joint angles `q` instead.
+
+    ## Episode End
+    Terminated (with the penalty) when a hand lies in a wall (`"obstacle"`; walls are tested
+    on the hand positions only, SPEC §4.2) or `‖(h_R − h_L) − (0.1, 0)‖ > drop_tolerance`
+    (`"drop"`); `info["end_reason"]` says which. Truncated after 1000 steps (the paper's).
+
+    ## Arguments
+    `drop_tolerance` (0.005 m, SPEC), `max_step` (0.1 rad), `render_mode`
+    (`None` or `"rgb_array"`).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+    target = np.array([-0.05, 0.47, 0.05, 0.47])
+    theta = 0.35
+    length_scale = 0.3
+    penalty = -1.0
+
+    def __init__(
+        self,
+        drop_tolerance: float = 0.005,
+        max_step: float = 0.1,
+        render_mode: str | None = None,
+    ) -> None:
+        if not (np.isfinite(drop_tolerance) and drop_tolerance > 0):
+            raise ValueError(f"drop_tolerance must be finite and > 0, got {drop_tolerance!r}")
+        if not (np.isfinite(max_step) and max_step > 0):
+            raise ValueError(f"max_step must be finite and > 0, got {max_step!r}")
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
+        self.drop_tolerance = float(drop_tolerance)
+        self.max_step = float(max_step)
+        self.render_mode = render_mode
+        self.sim = _native.Sim(arms_urdf(), solver_iterations=2)
+        self.dt = self.sim.dt
+        """One RL step (s): physics step × sub-steps."""
+        self.action_space = spaces.Box(-max_step, max_step, (4,), np.float64)
+        self.observation_space = spaces.Box(OBS_LOW, OBS_HIGH, (8,), np.float64)
+
+    @property
+    def posture(self) -> Obs:
+        """The reached joint angles (4,)."""
+        return self.sim.joint_positions()
+
+    def hands(self) -> Obs:
+        """The simulated hand positions `(x_L, y_L, x_R, y_R)`."""
+        left = self.sim.frame_position("left_hand")[:2]
+        return np.concatenate([left, self.sim.frame_position("right_hand")[:2]])
+
+    def _obs(self) -> Obs:
+        return np.concatenate([self.posture, self.hands()])
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Obs, dict[str, Any]]:
+        super().reset(seed=seed)
+        posture = _posture_option(options)
+        if posture is None:
+            left = np.array([-0.25, 0.15]) + self.np_random.uniform(-0.03, 0.03, 2)
+            posture = _native.arms_ik(np.concatenate([left, left + OFFSET])[None])[0]
+        self.sim.reset(posture)
+        return self._obs(), {}
+
+    def _end_reason(self, hands: Obs) -> str | None:
+        for x, y in (hands[:2], hands[2:]):
+            if any(x0 <= x <= x1 and y0 <= y <= y1 for x0, y0, x1, y1 in WALLS):
+                return "obstacle"
+        if np.linalg.norm(hands[2:] - hands[:2] - OFFSET) > self.drop_tolerance:
+            return "drop"
+        return None
+
+    def step(self, action: Obs) -> tuple[Obs, SupportsFloat, bool, bool, dict[str, Any]]:
+        delta = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
+        self.sim.set_targets(self.posture + delta)
+        self.sim.step()
+        obs = self._obs()
+        hands = obs[4:]
+        d2 = float(np.sum((hands - self.target) ** 2))
+        reward = float(np.exp(-self.theta * d2 / self.length_scale**2))
+        reason = self._end_reason(hands)
+        if reason is not None:
+            reward += self.penalty
+        info = {"end_reason": reason, "reached": bool(np.sqrt(d2 / 2) <= 0.05)}
+        return obs, reward, reason is not None, False, info
+
+    def render(self) -> NDArray[np.uint8] | None:
+        if self.render_mode != "rgb_array":
+            return None
+        from matplotlib.patches import Rectangle
+
+        fig, ax = _canvas()
+        ax.set(xlim=(-0.7, 0.7), ylim=(-0.2, 0.8))
+        for x0, y0, x1, y1 in WALLS:
+            ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, color="0.6"))
+        ax.plot(*self.target.reshape(2, 2).T, "g*", ms=10)
+        q = self.posture[None]
+        elbows, hands = arms_forward(q, elbows=True)[0], self.hands()
+        for arm, shoulder in enumerate((-0.15, 0.15)):
+            xs = [shoulder, elbows[2 * arm], hands[2 * arm]]
+            ys = [0.0, elbows[2 * arm + 1], hands[2 * arm + 1]]
+            ax.plot(xs, ys, "o-", color="C0", lw=3)
+        return _pixels(fig)
+
+
+class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstructorArgs):
+    """RL in the latent space of a fitted `PCA` or `GPLVM` (SPEC §3.1, Fig. 3).
+
+    The observation is the encoded reached posture `z = g(x̃)` (`model.transform`), clipped
+    into the latent box. An action is a latent delta `u` (clipped to the action space): a
+    target `z + u` outside the latent box is refused (no plant step, reward −1, terminated,
+    `info["end_reason"] = "box_exit"`, SPEC §3.1 step 2); otherwise it is decoded
+    (`model.inverse_transform`) to a posture target and handed to the wrapped environment as
+    the posture delta `x̂ − x` (which it clips to its own action space). With
+    `variance_threshold`, a target whose predictive variance (`model.predict_variance`,
+    GPLVM only) exceeds it is refused the same way (`"gated"`, SPEC §3.2).
+
+    `latent_box` = (low, high), each (d,); default: the bounding box of the GPLVM's latent
+    points `Z_` + 10 % per side (SPEC §4.2), or ± 3 s.d. (`explained_variance_`) for PCA.
+    `max_step`: the largest latent delta per dimension; default 0.02 × the box width
+    (about 0.4 RBF spacings of a 20-per-dimension grid).
+    """
+
+    penalty = -1.0
+
+    def __init__(
+        self,
+        env: gym.Env[Obs, Obs],
+        model: Any,
+        variance_threshold: float | None = None,
+        *,
+        latent_box: tuple[Any, Any] | None = None,
+        max_step: float | None = None,
+    ) -> None:
+        gym.utils.RecordConstructorArgs.__init__(
+            self,
+            model=model,
+            variance_threshold=variance_threshold,
+            latent_box=latent_box,
+            max_step=max_step,
+        )
+        gym.Wrapper.__init__(self, env)
+        posture = np.asarray(env.unwrapped.posture)  # type: ignore[attr-defined]
+        if getattr(model, "n_features_in_", None) != posture.shape[0]:
+            raise ValueError(
+                f"model must be fitted to postures of {posture.shape[0]} values, "
+                f"got n_features_in_={getattr(model, 'n_features_in_', None)!r}"
+            )
+        if variance_threshold is not None:
+            if not hasattr(model, "predict_variance"):
+                raise ValueError("variance_threshold needs a model with predict_variance (GPLVM)")
+            if not (np.isfinite(variance_threshold) and variance_threshold > 0):
+                raise ValueError(f"variance_threshold must be > 0, got {variance_threshold!r}")
+        d = int(model.n_components)
+        if latent_box is None:
+            if hasattr(model, "Z_"):
+                z = np.asarray(model.Z_)
+                pad = 0.1 * (z.max(axis=0) - z.min(axis=0))
+                low, high = z.min(axis=0) - pad, z.max(axis=0) + pad
+            else:
+                sd = np.sqrt(np.asarray(model.explained_variance_))
+                low, high = -3 * sd, 3 * sd
+        else:
+            low, high = (np.asarray(b, dtype=np.float64) for b in latent_box)
+        if low.shape != (d,) or high.shape != (d,) or not np.all(high > low):
+            raise ValueError(f"latent_box must be (low, high) of shape ({d},) with high > low")
+        step = 0.02 * (high - low) if max_step is None else np.full(d, max_step, dtype=np.float64)
+        if not np.all(np.isfinite(step) & (step > 0)):
+            raise ValueError(f"max_step must be finite and > 0, got {max_step!r}")
+        self.model = model
+        self.variance_threshold = variance_threshold
+        self.latent_low, self.latent_high, self.max_step = low, high, step
+        self.action_space = spaces.Box(-step, step, (d,), np.float64)
+        self.observation_space = spaces.Box(low, high, (d,), np.float64)
+        self.z = np.zeros(d)
+
+    def _encode(self) -> Obs:
+        posture = np.asarray(self.env.unwrapped.posture)  # type: ignore[attr-defined]
+        z = np.asarray(self.model.transform(posture[None])[0], dtype=np.float64)
+        return np.clip(z, self.latent_low, self.latent_high)
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Obs, dict[str, Any]]:
+        _, info = self.env.reset(seed=seed, options=options)
+        self.z = self._encode()
+        return self.z.copy(), info
+
+    def step(self, action: Obs) -> tuple[Obs, SupportsFloat, bool, bool, dict[str, Any]]:
+        u = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
+        target_z = self.z + u
+        refused = None
+        if np.any(target_z < self.latent_low) or np.any(target_z > self.latent_high):
+            refused = "box_exit"
+        elif self.variance_threshold is not None:
+            if float(self.model.predict_variance(target_z[None])[0]) > self.variance_threshold:
+                refused = "gated"
+        if refused is not None:
+            return self.z.copy(), self.penalty, True, False, {"end_reason": refused}
+        target = self.model.inverse_transform(target_z[None])[0]
+        posture = np.asarray(self.env.unwrapped.posture)  # type: ignore[attr-defined]
+        _, reward, terminated, truncated, info = self.env.step(target - posture)
+        self.z = self._encode()
+        return self.z.copy(), reward, terminated, truncated, info
+
+
+def _register() -> None:
+    for env_id, entry, steps in (
+        ("latentrl/BimanualReach-v0", "latentrl.envs:BimanualReachEnv", 500),
+        ("latentrl/TwoArms-v0", "latentrl.envs:TwoArmsEnv", 1000),
+    ):
+        if env_id not in gym.registry:
+            gym.register(id=env_id, entry_point=entry, max_episode_steps=steps)
+
+
+_register()

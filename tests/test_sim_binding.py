@@ -1,0 +1,102 @@
+"""The `Sim` binding (rapier3d world with PD servos): holding, tracking, FK, obstacles, errors."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from latentrl import InvalidInputError
+from latentrl._native import Sim, arms_ik
+from latentrl.datasets import arms_forward
+from latentrl.envs import arms_urdf
+
+START = arms_ik(np.array([[-0.25, 0.15, -0.15, 0.15]]))[0]
+
+
+@pytest.fixture
+def sim() -> Sim:
+    s = Sim(arms_urdf(), solver_iterations=2)
+    s.reset(START)
+    return s
+
+
+def hands(s: Sim) -> np.ndarray:
+    return np.concatenate([s.frame_position("left_hand")[:2], s.frame_position("right_hand")[:2]])
+
+
+def test_builds_from_path_or_xml():
+    from_path = Sim(Path(arms_urdf()))
+    from_xml = Sim(Path(arms_urdf()).read_text(), dt=1 / 480, substeps=24)
+    assert from_path.joint_names == ["left_shoulder", "left_elbow", "right_shoulder", "right_elbow"]
+    assert from_xml.joint_names == from_path.joint_names
+    assert from_path.dt == pytest.approx(0.05) and from_xml.dt == pytest.approx(0.05)
+    assert "two_arms" in repr(from_path)
+
+
+def test_holds_a_posture(sim):
+    for _ in range(20):
+        sim.step()
+    assert sim.time == pytest.approx(1.0)
+    np.testing.assert_allclose(sim.joint_positions(), START, atol=1e-3)
+    np.testing.assert_allclose(sim.joint_velocities(), 0.0, atol=1e-2)
+
+
+def test_tracks_a_target(sim):
+    target = START + np.array([0.1, -0.05, -0.08, 0.05])
+    sim.set_targets(target)
+    np.testing.assert_array_equal(sim.targets(), target)
+    sim.step()  # one RL step (0.05 s)
+    np.testing.assert_allclose(sim.joint_positions(), target, atol=2e-3)
+    sim.step(60)  # 60 physics steps
+    np.testing.assert_allclose(sim.joint_positions(), target, atol=1e-3)
+
+
+def test_hand_frames_match_the_numpy_kinematics(sim):
+    rng = np.random.default_rng(0)
+    postures = START + rng.uniform(-0.3, 0.3, (5, 4))
+    for q in postures:
+        sim.reset(q)
+        np.testing.assert_allclose(hands(sim), arms_forward(q[None])[0], atol=1e-5)
+        assert sim.frame_position("left_hand")[2] == pytest.approx(0.0, abs=1e-5)
+
+
+def test_box_obstacle_contacts(sim):
+    h = hands(sim)
+    assert sim.contacts() == []
+    far = sim.add_box_obstacle(np.array([0.0, -0.5, 0.0]), np.array([0.05, 0.05, 0.05]))
+    near = sim.add_box_obstacle(np.array([h[0], h[1], 0.0]), np.array([0.02, 0.02, 0.1]))
+    assert (far, near) == (0, 1)
+    found = sim.contacts()
+    assert found and all(obstacle == near for _, obstacle in found)
+    assert "left_forearm" in {link for link, _ in found}
+
+
+def test_bad_inputs_raise_clear_errors(sim):
+    with pytest.raises(InvalidInputError, match=r"posture.*\(4,\)"):
+        sim.reset(np.zeros(3))
+    with pytest.raises(InvalidInputError, match="outside the joint limits"):
+        sim.reset(np.array([0.0, 1.0, 0.0, 0.0]))
+    with pytest.raises(InvalidInputError, match="non-finite|NaN|finite"):
+        sim.set_targets(np.array([np.nan, 0.0, 0.0, 0.0]))
+    with pytest.raises(InvalidInputError, match="nowhere"):
+        sim.frame_position("nowhere")
+    with pytest.raises(InvalidInputError, match="half_extents"):
+        sim.add_box_obstacle(np.zeros(3), np.array([0.1, -1.0, 0.1]))
+    with pytest.raises(InvalidInputError, match=r"center: expected shape \(3,\)"):
+        sim.add_box_obstacle(np.zeros(2), np.ones(3))
+    with pytest.raises(InvalidInputError, match="n: expected an int >= 0"):
+        sim.step(-1)
+    with pytest.raises(InvalidInputError, match="root"):
+        Sim(arms_urdf(), root="loose")  # type: ignore[arg-type]
+    with pytest.raises(InvalidInputError, match="substeps"):
+        Sim(arms_urdf(), substeps=0)
+    with pytest.raises(InvalidInputError, match="dt"):
+        Sim(arms_urdf(), dt=-1.0)
+    with pytest.raises(InvalidInputError, match="kp|<any>"):
+        Sim(arms_urdf(), kp=-5.0)
+    with pytest.raises(InvalidInputError, match="gravity"):
+        Sim(arms_urdf(), gravity=np.zeros(2))
+    with pytest.raises(InvalidInputError):
+        Sim("/no/such/robot.urdf")
+    with pytest.raises(InvalidInputError):
+        Sim("<robot name='broken'>")
