@@ -22,6 +22,7 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from latentrl import _native
+from latentrl._validation import positive
 from latentrl.datasets import OFFSET, arms_forward
 
 __all__ = ["BimanualReachEnv", "LatentSpaceWrapper", "TwoArmsEnv"]
@@ -52,6 +53,13 @@ def _posture_option(options: dict[str, Any] | None) -> Obs | None:
         raise ValueError(f"options['posture']: expected 4 finite values, got {posture!r}")
     return posture
 
+
+
+def _check_render_mode(render_mode: str | None, modes: list[str]) -> str | None:
+    """`render_mode` if it is None or one of `modes`, else a ValueError."""
+    if render_mode not in (None, *modes):
+        raise ValueError(f"render_mode must be None or one of {modes}, got {render_mode!r}")
+    return render_mode
 
 class BimanualReachEnv(gym.Env[Obs, Obs]):
     """Two planar hands carrying an object to a target (paper Sec. IV-A, SPEC §4.1).
@@ -105,15 +113,9 @@ class BimanualReachEnv(gym.Env[Obs, Obs]):
         max_step: float = 0.05,
         render_mode: str | None = None,
     ) -> None:
-        if not (np.isfinite(drop_tolerance) and drop_tolerance > 0):
-            raise ValueError(f"drop_tolerance must be finite and > 0, got {drop_tolerance!r}")
-        if not (np.isfinite(max_step) and max_step > 0):
-            raise ValueError(f"max_step must be finite and > 0, got {max_step!r}")
-        if render_mode not in (None, *self.metadata["render_modes"]):
-            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
-        self.drop_tolerance = float(drop_tolerance)
-        self.max_step = float(max_step)
-        self.render_mode = render_mode
+        self.drop_tolerance = positive("drop_tolerance", drop_tolerance)
+        self.max_step = positive("max_step", max_step)
+        self.render_mode = _check_render_mode(render_mode, self.metadata["render_modes"])
         self.action_space = spaces.Box(-max_step, max_step, (4,), np.float64)
         low, high = self.box[0] - max_step, self.box[1] + max_step
         self.observation_space = spaces.Box(low, high, (4,), np.float64)
@@ -229,15 +231,9 @@ class TwoArmsEnv(gym.Env[Obs, Obs]):
         max_step: float = 0.1,
         render_mode: str | None = None,
     ) -> None:
-        if not (np.isfinite(drop_tolerance) and drop_tolerance > 0):
-            raise ValueError(f"drop_tolerance must be finite and > 0, got {drop_tolerance!r}")
-        if not (np.isfinite(max_step) and max_step > 0):
-            raise ValueError(f"max_step must be finite and > 0, got {max_step!r}")
-        if render_mode not in (None, *self.metadata["render_modes"]):
-            raise ValueError(f"render_mode must be None or 'rgb_array', got {render_mode!r}")
-        self.drop_tolerance = float(drop_tolerance)
-        self.max_step = float(max_step)
-        self.render_mode = render_mode
+        self.drop_tolerance = positive("drop_tolerance", drop_tolerance)
+        self.max_step = positive("max_step", max_step)
+        self.render_mode = _check_render_mode(render_mode, self.metadata["render_modes"])
         self.sim = _native.Sim(arms_urdf(), solver_iterations=2)
         self.dt = self.sim.dt
         """One RL step (s): physics step × sub-steps."""
