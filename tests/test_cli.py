@@ -1,9 +1,15 @@
-"""The `latentrl` command: help, info, runs, exit codes."""
+"""The `latentrl` command: help, info, runs, exit codes; results that do not depend on the
+thread count; runs interrupted (Ctrl-C) or killed mid-way and resumed to the uninterrupted result."""
 
 import json
+import os
+import signal
 import subprocess
 import sys
+import time
+from pathlib import Path
 
+import numpy as np
 import pytest
 
 from latentrl.cli import build_parser, main
@@ -28,6 +34,15 @@ def test_help_documents_every_preset_flag():
     exp1 = latentrl("run", "exp1", "--help")
     assert exp1.returncode == 0
     assert "--drop-tolerance" in exp1.stdout and "Soft-max inverse temperature" in exp1.stdout
+
+
+@pytest.mark.parametrize("experiment", ["table1", "exp1", "exp2"])
+def test_help_of_every_experiment_renders(experiment):
+    # A "%" in a field docstring once broke argparse's help formatting for exp2.
+    result = latentrl("run", experiment, "--help")
+    assert result.returncode == 0, result.stderr
+    assert "--seed" in result.stdout and "--out" in result.stdout
+    assert ("--resume" in result.stdout) == (experiment != "table1")
 
 
 def test_run_exp1_tiny(tmp_path):
@@ -60,8 +75,6 @@ def test_unknown_flag_exits_2():
     "script", ["table1.py", "exp1.py", pytest.param("exp2.py", marks=pytest.mark.slow)]
 )
 def test_examples_run_quick(script, tmp_path):
-    from pathlib import Path
-
     path = Path(__file__).resolve().parents[1] / "examples" / script
     result = subprocess.run(
         [sys.executable, str(path), "--quick", "--out", str(tmp_path)],
@@ -69,3 +82,123 @@ def test_examples_run_quick(script, tmp_path):
     )
     assert result.returncode == 0, result.stderr
     assert any(tmp_path.iterdir())
+
+
+# Small runs of each experiment; RL trials long enough (~1-3 s each) to be caught mid-way.
+TINY_RUNS = {
+    "table1": ["--quick", "--gplvm-max-iter", "200"],
+    "exp1": ["--quick", "--trials", "3", "--episodes", "40", "--steps", "300"],
+    "exp2": ["--quick", "--trials", "3", "--episodes", "20", "--steps", "500", "--test-episodes", "2",
+             "--fig5-samples", "200", "--gplvm-max-iter", "100"],
+}
+# Ctrl-C must reach the child even where the test runner was started with SIGINT ignored
+# (a background job of a non-interactive shell): the child restores Python's handler.
+CHILD = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+         "from latentrl.cli import main; sys.exit(main(sys.argv[1:]))")
+
+
+def start(experiment, out, threads, *extra):
+    args = ["run", experiment, "--no-progress", *TINY_RUNS[experiment], "--out", str(out), *extra]
+    env = {**os.environ, "RAYON_NUM_THREADS": str(threads)}
+    return subprocess.Popen([sys.executable, "-c", CHILD, *args], env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+
+
+def without_timings(value):
+    """`value` without its wall times (keys ending in "seconds"), at any depth."""
+    if isinstance(value, dict):
+        return {k: without_timings(v) for k, v in value.items() if not k.endswith("seconds")}
+    if isinstance(value, list):
+        return [without_timings(v) for v in value]
+    return value
+
+
+def results_of(out):
+    """What a run's results must reproduce: every array, and the per-trial summaries."""
+    if (out / "table1.json").exists():
+        saved = json.loads((out / "table1.json").read_text())
+        return without_timings({"trials": saved["trials"], "summary": saved["summary"]})
+    with np.load(out / "returns.npz") as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    return {"trials": json.loads((out / "results.json").read_text())["trials"], **arrays}
+
+
+def assert_same_results(a, b):
+    assert a.keys() == b.keys()
+    for key in a:
+        if isinstance(a[key], np.ndarray):
+            np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+        else:
+            assert a[key] == b[key], key
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(tmp_path_factory):
+    """Each experiment's tiny run, once with 1 thread and once with 2: results by (experiment, threads)."""
+    runs = {}
+    for experiment in TINY_RUNS:
+        for threads in (1, 2):
+            out = tmp_path_factory.mktemp(f"{experiment}_{threads}")
+            proc = start(experiment, out, threads)
+            _, err = proc.communicate(timeout=300)
+            assert proc.returncode == 0, err
+            runs[experiment, threads] = results_of(out)
+    return runs
+
+
+@pytest.mark.parametrize("experiment", list(TINY_RUNS))
+def test_thread_count_does_not_change_results(uninterrupted, experiment):
+    assert_same_results(uninterrupted[experiment, 1], uninterrupted[experiment, 2])
+
+
+def wait_for_first_trial(out, proc, timeout=240):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        assert proc.poll() is None, proc.communicate()[1]
+        try:
+            if json.loads((out / "results.json").read_text())["trials"]:
+                return
+        except (OSError, ValueError, KeyError):
+            pass
+        time.sleep(0.02)
+    raise AssertionError("no trial finished in time")
+
+
+@pytest.mark.parametrize("experiment", ["exp1", "exp2"])
+@pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGKILL], ids=["ctrl-c", "kill-9"])
+def test_run_stopped_mid_way_resumes_to_the_uninterrupted_result(uninterrupted, tmp_path, experiment, how):
+    out = tmp_path / "run"
+    proc = start(experiment, out, 1)  # one thread: one trial per chunk, saved as it finishes
+    wait_for_first_trial(out, proc)
+    proc.send_signal(how)
+    sent = time.monotonic()
+    _, err = proc.communicate(timeout=30)
+    stopped_after = time.monotonic() - sent
+    if how == signal.SIGINT:
+        # Ctrl-C stops within a second (the native loop polls signals every 0.1 s) and says
+        # how to continue.
+        assert proc.returncode == 130, err
+        assert stopped_after < 1.0, stopped_after
+        assert f"--resume {out}" in err
+    else:
+        assert proc.returncode == -signal.SIGKILL
+    with np.load(out / "returns.npz") as npz:  # whatever was saved is whole (atomic writes)
+        done = (npz["latent_end"][:, 0] >= 0).sum()
+    assert 1 <= done < 3, f"expected the run stopped mid-way, {done} of 3 latent trials done"
+    resumed = latentrl("run", experiment, "--no-progress", "--resume", str(out))
+    assert resumed.returncode == 0, resumed.stderr
+    assert_same_results(results_of(out), uninterrupted[experiment, 1])
+    assert not list(out.glob(".*.tmp")), "a killed write's temporary file was left behind"
+
+
+def test_resume_refuses_flags_and_foreign_directories(tmp_path):
+    result = latentrl("run", "exp1", "--resume", str(tmp_path), "--trials", "3", "--quick")
+    assert result.returncode == 2 and "drop --quick --trials" in result.stderr
+    result = latentrl("run", "exp1", "--resume", str(tmp_path))
+    assert result.returncode == 1 and "no results.json" in result.stderr
+    (tmp_path / "results.json").write_text(json.dumps({"preset": {"name": "Exp2Preset", "trials": 1}}))
+    result = latentrl("run", "exp1", "--resume", str(tmp_path))
+    assert result.returncode == 1 and "holds a run of Exp2Preset, not of Exp1Preset" in result.stderr
+    (tmp_path / "results.json").write_text(json.dumps({"preset": {"name": "Exp1Preset", "trialz": 1}}))
+    result = latentrl("run", "exp1", "--resume", str(tmp_path))
+    assert result.returncode == 1 and "does not know: ['trialz']" in result.stderr

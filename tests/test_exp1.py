@@ -2,9 +2,6 @@
 
 import dataclasses
 import json
-import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -42,6 +39,8 @@ def test_results_layout_follows_spec(quick_run):
     assert saved["preset"] == {"name": "Exp1Preset", **dataclasses.asdict(preset)}
     assert saved["environment"]["versions"]["numpy"] == np.__version__
     assert saved["wall_time_s"] > 0 and set(saved["trials"]) == {"latent", "full"}
+    # Peak resident memory is recorded; the bound for a full run is 2 GiB.
+    assert 10 < saved["peak_rss_mib"] < 2048
     with np.load(out / "returns.npz") as npz:
         for name in ("latent", "full"):
             assert npz[name].shape == npz[f"{name}_end"].shape == (preset.trials, preset.episodes)
@@ -90,18 +89,3 @@ def test_a_different_preset_in_the_same_directory_is_refused(tmp_path):
     run_exp1(TINY, tmp_path, progress=False)
     with pytest.raises(ValueError, match="different preset"):
         run_exp1(dataclasses.replace(TINY, beta=5.0), tmp_path, progress=False)
-
-
-def test_thread_count_does_not_change_results(tmp_path):
-    arrays = []
-    for threads in ("1", "2"):
-        out = tmp_path / threads
-        env = {**os.environ, "RAYON_NUM_THREADS": threads}
-        cmd = [sys.executable, "-m", "latentrl", "run", "exp1", "--quick", "--no-progress",
-               "--trials", "2", "--episodes", "40", "--steps", "100", "--out", str(out)]
-        subprocess.run(cmd, env=env, check=True, capture_output=True, timeout=300)
-        with np.load(out / "returns.npz") as npz:
-            arrays.append({k: npz[k] for k in npz.files})
-    assert arrays[0].keys() == arrays[1].keys()
-    for key in arrays[0]:
-        np.testing.assert_array_equal(arrays[0][key], arrays[1][key], err_msg=key)

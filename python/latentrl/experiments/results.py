@@ -6,6 +6,7 @@ import dataclasses
 import json
 import os
 import platform
+import resource
 import subprocess
 import tempfile
 from collections.abc import Callable, Mapping
@@ -32,6 +33,13 @@ def write_atomic(path: Path, write: Callable[[BinaryIO], None]) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def remove_stale_temporaries(path: Path) -> None:
+    """Deletes temporary files that `write_atomic` left beside `path` when a process was killed
+    while writing it (the file itself is always whole: the old or the new version)."""
+    for stale in path.parent.glob(f".{path.name}.*.tmp"):
+        stale.unlink(missing_ok=True)
 
 
 def write_json(path: Path, payload: Mapping[str, Any]) -> None:
@@ -83,8 +91,27 @@ def environment() -> dict[str, Any]:
         "platform": platform.platform(),
         "git_revision": _git_revision(),
         "cpu_count": os.cpu_count(),
-        "rayon_threads": int(os.environ.get("RAYON_NUM_THREADS", 0)) or os.cpu_count(),
+        "rayon_threads": worker_threads(),
     }
+
+
+def worker_threads() -> int:
+    """Threads the native trial runners use, as rayon picks them: RAYON_NUM_THREADS if it is a
+    positive integer, else the CPUs this process may run on. Runs are split into chunks of this
+    many trials; the results do not depend on it."""
+    try:
+        requested = int(os.environ.get("RAYON_NUM_THREADS", ""))
+    except ValueError:
+        requested = 0
+    if requested > 0:
+        return requested
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+
+
+def peak_rss_mib() -> float:
+    """Peak resident memory of this process so far, MiB (`getrusage`; Linux reports KiB)."""
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / (1024 * 1024 if platform.system() == "Darwin" else 1024)
 
 
 def _git_revision() -> str | None:

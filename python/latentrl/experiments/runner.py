@@ -9,7 +9,6 @@ in the same directory is an error.
 
 from __future__ import annotations
 
-import os
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -20,7 +19,15 @@ import numpy as np
 from tqdm import tqdm
 
 from latentrl.experiments.presets import describe
-from latentrl.experiments.results import environment, read_json, write_json, write_npz
+from latentrl.experiments.results import (
+    environment,
+    peak_rss_mib,
+    read_json,
+    remove_stale_temporaries,
+    worker_threads,
+    write_json,
+    write_npz,
+)
 
 END_CODES = {0: "timeout", 1: "obstacle", 2: "box_exit", 3: "drop", 4: "fall", 5: "variance_gate"}
 """How an episode ended, as stored in `<learner>_end` (−1: not run)."""
@@ -94,7 +101,7 @@ def run_rl(
     arrays, meta = _previous(meta_path, arrays_path, plan)
     started = time.perf_counter()
     built = setup(preset)
-    chunk = chunk or max(os.cpu_count() or 1, 1)
+    chunk = chunk or worker_threads()
     if meta is None:
         meta = {"preset": plan, "environment": environment(), "setup": built.info, "wall_time_s": 0.0}
     for name in built.learners:
@@ -125,6 +132,7 @@ def run_rl(
                         arrays.setdefault(array_key(name, key), _unset(value, preset.trials))[t] = value[i]
                 meta["trials"].setdefault(name, {})[str(t)] = summarise_trial(arrays, name, t)
             meta["wall_time_s"] += time.perf_counter() - started
+            meta["peak_rss_mib"] = max(meta.get("peak_rss_mib", 0.0), peak_rss_mib())
             started = time.perf_counter()
             _save(meta_path, arrays_path, meta, arrays)
     finally:
@@ -201,6 +209,8 @@ def _previous(
     meta_path: Path, arrays_path: Path, plan: dict[str, Any]
 ) -> tuple[dict[str, np.ndarray], dict[str, Any] | None]:
     """Arrays and metadata of an earlier run of the same preset in this directory, if any."""
+    for path in (meta_path, arrays_path):
+        remove_stale_temporaries(path)
     if not meta_path.exists():
         return {}, None
     meta = read_json(meta_path)

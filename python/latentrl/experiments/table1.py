@@ -32,7 +32,7 @@ import numpy as np
 
 from latentrl.datasets import arm_postures, arms_forward, bimanual_pairs, grip_error
 from latentrl.experiments.presets import check_floats, check_ints, describe
-from latentrl.experiments.results import environment, write_atomic, write_json
+from latentrl.experiments.results import environment, worker_threads, write_atomic, write_json
 
 SPACES = ("end_effector", "joint")
 METHODS = ("PCA", "GPLVM")
@@ -94,7 +94,8 @@ class Table1Preset:
     variant_noise_floor: float = 1e-4
     """θ3 floor of the noise-floor variant fits."""
     workers: int = 0
-    """Worker processes over trials; 0 = one per CPU (at most `trials`), 1 = in this process."""
+    """Worker processes over trials; 0 = one per rayon thread (RAYON_NUM_THREADS, else one per
+    CPU; at most `trials`), 1 = in this process. The results do not depend on it."""
 
     @classmethod
     def quick(cls) -> Table1Preset:
@@ -433,7 +434,7 @@ def _single_threaded_children() -> Iterator[None]:
 def _n_workers(preset: Table1Preset) -> int:
     if preset.workers:
         return min(preset.workers, preset.trials)
-    return max(1, min(os.cpu_count() or 1, preset.trials))
+    return max(1, min(worker_threads(), preset.trials))
 
 
 def run_table1(
