@@ -35,13 +35,17 @@ class NotFittedError(LatentrlError, AttributeError):
 
 
 def atomic_write(path: PathLike, write: Callable[[IO[bytes]], None]) -> None:
-    """Calls `write` on a temporary file beside `path`, then renames it over `path`, so an
-    interrupted write never leaves a half-written file."""
+    """Calls `write` on a temporary file beside `path` (creating missing parent directories),
+    flushes it to disk, then renames it over `path`, so an interrupted write never leaves a
+    half-written file. A process killed mid-write leaves only `.{name}.<hex>.tmp` behind."""
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
     try:
         with open(tmp, "xb") as fh:
             write(fh)
+            fh.flush()
+            os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
         tmp.unlink(missing_ok=True)

@@ -15,7 +15,7 @@ from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
-from latentrl.experiments.results import write_atomic  # noqa: E402
+from latentrl._base import atomic_write  # noqa: E402
 
 
 def running_mean(values: NDArray[np.float64], window: int) -> NDArray[np.float64]:
@@ -73,7 +73,7 @@ def save_figure(fig: Figure, out_dir: Path, name: str) -> list[Path]:
         buffer = io.BytesIO()
         fig.savefig(buffer, format=ext, dpi=150, bbox_inches="tight")
         path = Path(out_dir) / f"{name}.{ext}"
-        write_atomic(path, lambda f: f.write(buffer.getvalue()))
+        atomic_write(path, lambda f: f.write(buffer.getvalue()))
         written.append(path)
     plt.close(fig)
     return written

@@ -8,35 +8,21 @@ import os
 import platform
 import resource
 import subprocess
-import tempfile
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from importlib import metadata
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any
 
 import numpy as np
+
+from latentrl._base import atomic_write
 
 RESULTS_FORMAT = 1
 """Version of the results layout; bumped when a file changes meaning."""
 
 
-def write_atomic(path: Path, write: Callable[[BinaryIO], None]) -> None:
-    """Writes `path` through `write(file)` into a temporary file beside it, then renames it into place."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            write(handle)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def remove_stale_temporaries(path: Path) -> None:
-    """Deletes temporary files that `write_atomic` left beside `path` when a process was killed
+    """Deletes temporary files that `atomic_write` left beside `path` when a process was killed
     while writing it (the file itself is always whole: the old or the new version)."""
     for stale in path.parent.glob(f".{path.name}.*.tmp"):
         stale.unlink(missing_ok=True)
@@ -45,12 +31,12 @@ def remove_stale_temporaries(path: Path) -> None:
 def write_json(path: Path, payload: Mapping[str, Any]) -> None:
     """Atomic, indented JSON; NumPy scalars and arrays become plain numbers and lists."""
     text = json.dumps(payload, indent=2, default=_to_plain, allow_nan=True)
-    write_atomic(path, lambda f: f.write(text.encode()))
+    atomic_write(path, lambda f: f.write(text.encode()))
 
 
 def write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
     """Atomic compressed NPZ."""
-    write_atomic(path, lambda f: np.savez_compressed(f, **arrays))
+    atomic_write(path, lambda f: np.savez_compressed(f, **arrays))
 
 
 def read_json(path: Path) -> dict[str, Any]:

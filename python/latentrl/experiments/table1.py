@@ -30,9 +30,10 @@ from typing import Any
 
 import numpy as np
 
+from latentrl._base import atomic_write
 from latentrl.datasets import arm_postures, arms_forward, bimanual_pairs, grip_error
 from latentrl.experiments.presets import check_floats, check_ints, describe
-from latentrl.experiments.results import environment, worker_threads, write_atomic, write_json
+from latentrl.experiments.results import environment, worker_threads, write_json
 
 SPACES = ("end_effector", "joint")
 METHODS = ("PCA", "GPLVM")
@@ -484,7 +485,7 @@ def run_table1(
     if out_dir is not None:
         out = Path(out_dir)
         write_json(out / "table1.json", result)
-        write_atomic(out / "table1.md", lambda f: f.write(("# Table I\n\n" + table).encode()))
+        atomic_write(out / "table1.md", lambda f: f.write(("# Table I\n\n" + table).encode()))
     return result
 
 
