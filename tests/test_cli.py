@@ -1,6 +1,7 @@
 """The `latentrl` command: help, info, runs, exit codes; results that do not depend on the
 thread count; runs interrupted (Ctrl-C) or killed mid-way and resumed to the uninterrupted result."""
 
+import dataclasses
 import json
 import os
 import signal
@@ -198,7 +199,65 @@ def test_resume_refuses_flags_and_foreign_directories(tmp_path):
     assert result.returncode == 1 and "no results.json" in result.stderr
     (tmp_path / "results.json").write_text(json.dumps({"preset": {"name": "Exp2Preset", "trials": 1}}))
     result = latentrl("run", "exp1", "--resume", str(tmp_path))
-    assert result.returncode == 1 and "holds a run of Exp2Preset, not of Exp1Preset" in result.stderr
+    assert result.returncode == 1 and "holds a run of exp2, not of exp1" in result.stderr
+    (tmp_path / "results.json").write_text(json.dumps({"preset": {"name": "Table1Preset"}}))
+    result = latentrl("run", "exp1", "--resume", str(tmp_path))
+    assert result.returncode == 1 and "names no RL experiment's preset (found 'Table1Preset')" in result.stderr
     (tmp_path / "results.json").write_text(json.dumps({"preset": {"name": "Exp1Preset", "trialz": 1}}))
     result = latentrl("run", "exp1", "--resume", str(tmp_path))
     assert result.returncode == 1 and "does not know: ['trialz']" in result.stderr
+
+
+@pytest.mark.parametrize("model", ["gplvm", "pca"])
+def test_fit_saves_the_model_a_fit_in_python_gives(tmp_path, model):
+    from latentrl import GPLVM, PCA, Demonstrations, save_demos
+    from latentrl.datasets import arm_postures
+
+    postures = arm_postures(40, np.random.default_rng(0))
+    names = ("left_shoulder", "left_elbow", "right_shoulder", "right_elbow")
+    save_demos(Demonstrations(postures, names), tmp_path / "demos.csv")
+    result = latentrl("fit", str(tmp_path / "demos.csv"), "--model", model, "--max-iter", "30",
+                      "--out", str(tmp_path / "model.npz"))
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    assert summary["joint_names"] == list(names) and summary["postures"] == 40
+    if model == "gplvm":
+        expected = GPLVM(n_components=2, max_iter=30, random_state=0).fit(postures)
+        loaded = GPLVM.load(tmp_path / "model.npz")
+        assert summary["nll"] == expected.nll_
+    else:
+        expected, loaded = PCA(n_components=2).fit(postures), PCA.load(tmp_path / "model.npz")
+    np.testing.assert_array_equal(loaded.transform(postures), expected.transform(postures))
+
+
+def test_fit_reports_bad_demonstration_files(tmp_path):
+    result = latentrl("fit", str(tmp_path / "missing.csv"), "--out", str(tmp_path / "m.npz"))
+    assert result.returncode == 1 and "missing.csv" in result.stderr
+    (tmp_path / "two.csv").write_text("a,b,c\n0,1,2\n1,2,3\n")
+    result = latentrl("fit", str(tmp_path / "two.csv"), "--out", str(tmp_path / "m.npz"))
+    assert result.returncode == 1 and "2 postures, expected at least 3" in result.stderr
+    assert not (tmp_path / "m.npz").exists()
+
+
+def test_plot_redraws_the_finished_trials_of_a_partial_run(tmp_path):
+    from latentrl.experiments.exp1 import Exp1Preset, run_exp1
+    from latentrl.experiments.results import write_npz
+    from latentrl.experiments.runner import finished_trials, load_arrays
+
+    run_exp1(dataclasses.replace(Exp1Preset.quick(), trials=2, episodes=5, steps=20), tmp_path / "run",
+             progress=False)
+    arrays = load_arrays(tmp_path / "run")
+    arrays["full_end"][1] = -1  # as an interrupted run leaves it: full trial 2 not run
+    arrays["full"][1] = np.nan
+    write_npz(tmp_path / "run" / "returns.npz", arrays)
+    kept, done = finished_trials(arrays)
+    assert done == {"latent": 2, "full": 1}
+    assert kept["latent"].shape == (2, 5) and kept["full"].shape == kept["full_end"].shape == (1, 5)
+    np.testing.assert_array_equal(kept["full_steps"], arrays["full_steps"][:1])
+    result = latentrl("plot", str(tmp_path / "run"), "--out", str(tmp_path / "figs"))
+    assert result.returncode == 0, result.stderr
+    assert "latent 2 of 2, full 1 of 2 trials" in result.stdout
+    for fig in ("fig4a", "fig4b", "fig4c"):
+        assert (tmp_path / "figs" / f"{fig}.png").stat().st_size > 1000
+    result = latentrl("plot", str(tmp_path / "figs"))
+    assert result.returncode == 1 and "no results.json" in result.stderr

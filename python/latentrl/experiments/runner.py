@@ -18,6 +18,7 @@ from typing import Any, Protocol
 import numpy as np
 from tqdm import tqdm
 
+from latentrl._base import read_npz
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
     environment,
@@ -221,8 +222,25 @@ def _previous(
         )
     if not arrays_path.exists():
         return {}, None
-    with np.load(arrays_path, allow_pickle=False) as npz:
-        return {k: npz[k] for k in npz.files}, meta
+    return load_arrays(arrays_path.parent), meta
+
+
+def load_arrays(out_dir: Path | str) -> dict[str, np.ndarray]:
+    """Every array of a results directory's returns.npz (a ValueError if it is not readable)."""
+    return read_npz(Path(out_dir) / "returns.npz")
+
+
+def finished_trials(arrays: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+    """The rows of finished trials only, learner by learner (a partial run's unrun trials are
+    NaN or −1), and how many each learner has. Learners with none are left out."""
+    learners = [key for key in arrays if array_key(key, "ends") in arrays]
+    done = {name: arrays[array_key(name, "ends")][:, 0] >= 0 for name in learners}
+    kept: dict[str, np.ndarray] = {}
+    for key, value in arrays.items():
+        owner = max((n for n in learners if key == n or key.startswith(n + "_")), key=len, default=None)
+        if owner is not None and done[owner].any():
+            kept[key] = value[done[owner]]
+    return kept, {name: int(mask.sum()) for name, mask in done.items() if mask.any()}
 
 
 def _save(meta_path: Path, arrays_path: Path, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
