@@ -4,7 +4,9 @@ VENV := .venv
 PY := $(VENV)/bin/python
 export CARGO_TARGET_DIR ?= $(CURDIR)/target
 
-.PHONY: help demo test test-all bench lint build clean
+INSTALL_VENV := target/install-check-venv
+
+.PHONY: help demo test test-all bench lint build install-check fuzz clean
 .DEFAULT_GOAL := help
 
 help: ## list the targets
@@ -26,26 +28,49 @@ demo: build ## reproduce Table I and Experiment 1 (Fig. 4) on defaults into resu
 	$(PY) -m latentrl run table1 --out results/table1
 	$(PY) -m latentrl run exp1 --out results/exp1
 
-test: lint ## clippy, stub check, Rust tests (pure crates and the binding's panic guard) and the default pytest run
+test: lint ## clippy, stub check, Rust tests (pure crates and the binding's panic guard), the default pytest run, install check
 	cargo test --quiet
 	cargo test --quiet -p latentrl_py --lib
 	$(PY) -m pytest -q
+	$(MAKE) --no-print-directory install-check
 
 test-all: lint ## everything, slow reproductions included
 	cargo test --quiet
 	cargo test --quiet -p latentrl_py --lib
 	$(PY) -m pytest -q -m ''
 
-bench: build ## criterion benches, the NumPy loop and GPy comparisons (JSON in benches/results/)
+bench: build ## criterion benches, the NumPy loop, GPy and MuJoCo comparisons (JSON in benches/results/)
 	cargo bench -p latent_core -p sim
 	$(PY) benches/bench_td.py
 	bash benches/setup_bench_env.sh
 	benches/.venv-bench/bin/python benches/bench_gp.py
+	benches/.venv-bench/bin/python benches/bench_sim.py
 
 lint: build ## rustfmt, clippy (warnings are errors) and the native stubs against the module
 	cargo fmt --all --check
 	cargo clippy --quiet --workspace --all-targets -- -D warnings
 	$(PY) -m mypy.stubtest latentrl._native
+
+install-check: ## `pip install .` into a fresh venv as a user would, then use the installed package from outside the tree
+	rm -rf $(INSTALL_VENV)
+	$(PYTHON) -m venv $(INSTALL_VENV)
+	$(INSTALL_VENV)/bin/python -m pip install --quiet --upgrade pip
+	$(INSTALL_VENV)/bin/python -m pip install --quiet .
+	cd $(INSTALL_VENV) && bin/python -c "import sys, latentrl; sys.exit(latentrl.__file__.startswith('$(CURDIR)/python'))"
+	cd $(INSTALL_VENV) && bin/python -m latentrl info > /dev/null
+	cd $(INSTALL_VENV) && bin/latentrl run exp2 --quick --no-progress --trials 1 --episodes 2 --steps 10 \
+		--test-episodes 1 --fig5-samples 50 --gplvm-max-iter 20 --out run
+	cd $(INSTALL_VENV) && test -s run/results.json && test -s run/fig6a.png && echo "install-check: pip install . works"
+
+FUZZ_TARGET ?= urdf_parse
+FUZZ_SECONDS ?= 180
+
+fuzz: ## cargo fuzz the URDF parser + physics for FUZZ_SECONDS (180) s; FUZZ_TARGET=urdf_parse|urdf_numbers; installs cargo-fuzz if missing
+	@command -v cargo-fuzz > /dev/null || cargo install --locked cargo-fuzz
+	mkdir -p fuzz/corpus/$(FUZZ_TARGET)
+	RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(CURDIR)/fuzz/target nice -n 10 cargo fuzz run --sanitizer none $(FUZZ_TARGET) \
+		fuzz/corpus/$(FUZZ_TARGET) fuzz/seeds -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 -dict=fuzz/urdf.dict \
+		-print_final_stats=1
 
 clean: ## remove the venv and build outputs
 	rm -rf $(VENV) target
