@@ -23,12 +23,10 @@ GPy's exact inference adds a constant 1e-8 to K's diagonal, so its likelihood va
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
 import statistics
 import sys
-import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -45,6 +43,7 @@ from latentrl._native import GpMap, gplvm_nll_grad
 from latentrl._reference import gplvm_nll_grad as numpy_nll_grad
 from latentrl._reference import se_kernel
 from latentrl.datasets import arm_postures
+from latentrl.experiments.results import write_json
 from latentrl.pca import PCA
 
 try:
@@ -466,18 +465,6 @@ def machine() -> dict[str, Any]:
     return info
 
 
-def write_atomic_json(path: Path, payload: dict[str, Any]) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as handle:
-            json.dump(payload, handle, indent=2)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -560,7 +547,7 @@ def main(argv: list[str] | None = None) -> int:
         "cases": cases,
         "targets": targets,
     }
-    write_atomic_json(args.out, payload)
+    write_json(args.out, payload)
     print(f"\nwrote {args.out}")
     return 0
 

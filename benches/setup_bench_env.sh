@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Creates benches/.venv-bench: GPy (the peer, never a runtime dependency of latentrl) and a
-# release wheel of latentrl built from this tree, in a venv of their own so GPy's pins cannot
-# touch the project's .venv. Idempotent; re-run after changing Rust code to refresh the wheel.
+# Creates benches/.venv-bench: the peers GPy and MuJoCo (never runtime dependencies of
+# latentrl) and a release wheel of latentrl built from this tree, in a venv of their own so the
+# peers' pins cannot touch the project's .venv. Idempotent; re-run after changing Rust code to
+# refresh the wheel.
 #
 #   bash benches/setup_bench_env.sh && benches/.venv-bench/bin/python benches/bench_gp.py
+#   benches/.venv-bench/bin/python benches/bench_sim.py
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -15,7 +17,7 @@ if [ ! -x "$VENV/bin/python" ]; then
     "$PYTHON" -m venv "$VENV"
     "$VENV/bin/python" -m pip install --quiet --upgrade pip
 fi
-"$VENV/bin/python" -m pip install --quiet "GPy>=1.13" threadpoolctl
+"$VENV/bin/python" -m pip install --quiet "GPy>=1.13" "mujoco>=3.13" threadpoolctl
 
 if [ ! -x "$MATURIN" ]; then
     echo "setup_bench_env: $MATURIN not found; run 'make build' first or set MATURIN" >&2
@@ -27,4 +29,4 @@ trap 'rm -rf "$WHEELS"' EXIT
 "$MATURIN" build --release --quiet -o "$WHEELS"
 "$VENV/bin/python" -m pip install --quiet --force-reinstall --no-deps "$WHEELS"/latentrl-*.whl
 "$VENV/bin/python" -m pip install --quiet "$WHEELS"/latentrl-*.whl   # its dependencies, pins kept
-"$VENV/bin/python" -c "import GPy, numpy, latentrl; print('bench env: GPy', GPy.__version__, 'numpy', numpy.__version__, 'latentrl', latentrl.__version__)"
+"$VENV/bin/python" -c "import GPy, mujoco, numpy, latentrl; print('bench env: GPy', GPy.__version__, 'MuJoCo', mujoco.__version__, 'numpy', numpy.__version__, 'latentrl', latentrl.__version__)"

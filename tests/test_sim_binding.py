@@ -100,3 +100,29 @@ def test_bad_inputs_raise_clear_errors(sim):
         Sim("/no/such/robot.urdf")
     with pytest.raises(InvalidInputError):
         Sim("<robot name='broken'>")
+
+
+def test_floating_humanoid_stands_on_the_ground_and_falls_without_it():
+    from latentrl.humanoid import PHYSICS, SERVO, model, urdf_path
+
+    kin = model()
+    home = np.zeros(len(kin.joint_names))
+    poses = kin.link_poses(home)  # Sim.reset leaves the floating base at the identity
+    sole = min(c[2] for s in ("l_foot", "r_foot") for c in kin.sole_corners(poses, s))
+    heights = {}
+    for ground in (sole - 5e-4, None):
+        s = Sim(urdf_path(), root="floating", substeps=24, ground=ground, **SERVO, **PHYSICS)
+        s.reset(home)
+        start = s.frame_position("torso")[2]
+        for _ in range(10):  # 1 s
+            s.step()
+        heights[ground is not None] = (start, s.frame_position("torso")[2])
+    start, end = heights[True]
+    assert end == pytest.approx(start, abs=3e-3)  # standing: the servos sag by ~1 mm
+    start, end = heights[False]
+    assert end < start - 1.0  # free fall for 1 s: ~4.9 m
+
+
+def test_ground_must_be_finite():
+    with pytest.raises(InvalidInputError, match="ground"):
+        Sim(arms_urdf(), ground=float("nan"))

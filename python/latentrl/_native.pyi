@@ -84,9 +84,11 @@ class Sim:
         kd: float = 50.0,
         max_force: float = ...,
         gravity: NDArray[np.float64] | None = None,
+        ground: float | None = None,
     ) -> Sim:
         """Builds the world from `urdf`: a path, or the URDF XML itself (a str starting
-        with `<`)."""
+        with `<`). `ground` is the height of a floor half-space (normal +z), or None for no
+        floor."""
     @property
     def joint_names(self) -> list[str]:
         """Names of the actuated joints, in the order of postures and targets."""

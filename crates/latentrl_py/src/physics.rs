@@ -25,10 +25,11 @@ pub struct PySim {
 #[pymethods]
 impl PySim {
     /// Builds the world from `urdf`: a path, or the URDF XML itself (a str starting with `<`).
+    /// `ground` is the height of a floor half-space (normal +z), or None for no floor.
     #[new]
     #[pyo3(signature = (
         urdf, *, root = "fixed", dt = 1.0 / 240.0, substeps = 12, solver_iterations = 4,
-        kp = 5000.0, kd = 50.0, max_force = f64::INFINITY, gravity = None
+        kp = 5000.0, kd = 50.0, max_force = f64::INFINITY, gravity = None, ground = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -42,6 +43,7 @@ impl PySim {
         kd: f64,
         max_force: f64,
         gravity: Option<PyReadonlyArray1<'_, f64>>,
+        ground: Option<f64>,
     ) -> PyResult<Self> {
         guard(|| {
             let root = match root {
@@ -65,6 +67,7 @@ impl PySim {
                 substeps: count("substeps", substeps)?,
                 solver_iterations: count("solver_iterations", solver_iterations)?,
                 gains: PdGains::new(kp, kd, max_force).map_err(sim_to_py)?,
+                ground,
                 ..SimOptions::default()
             };
             if let Some(g) = gravity {

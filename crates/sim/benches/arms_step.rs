@@ -1,7 +1,8 @@
 //! Two planar arms on rapier3d 0.36.1: physics steps/s and RL steps/s (SPEC §4.2), and
 //! the Experiment 2 plant ([`sim::ArmsPlant`]) alone and inside a latent learner's step.
 //!
-//! Peers (PEERS.md): MuJoCo 4.1 µs per step (dt 2 ms), rapier's PyPI wheel 2.4 µs.
+//! Peers (PEERS.md): MuJoCo 4.1 µs per step (dt 2 ms), rapier's PyPI wheel 2.4 µs; MuJoCo on
+//! the same URDF and settings is measured side by side in `benches/bench_sim.py`.
 //! Run: `cargo bench -p sim --bench arms_step`.
 use std::hint::black_box;
 

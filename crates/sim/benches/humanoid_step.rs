@@ -1,0 +1,82 @@
+//! The KHR-1HV-like humanoid on rapier3d 0.36.1: physics steps/s of the free-floating robot
+//! standing on the ground under servo PD (SPEC §4.3; kp 8 N·m/rad, kd 0.1 N·m·s/rad, ±1.2 N·m,
+//! dt 1/240), at its home posture and at the first lift demo, at 4 solver iterations (the fall
+//! check) and 1 (it also stands, docs/humanoid.md).
+//!
+//! Peer: MuJoCo on the same URDF, measured side by side in `benches/bench_sim.py`.
+//! Run: `cargo bench -p sim --bench humanoid_step`.
+use std::hint::black_box;
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use sim::humanoid::reset_on_ground;
+use sim::{PdGains, PhysicsSim, RootMode, SimOptions, UrdfModel};
+
+const KHR1HV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/khr1hv.urdf");
+const DEMOS: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../python/latentrl/data/khr1hv_lift_demos.csv"
+);
+/// Physics steps per timed iteration.
+const STEPS: usize = 10;
+/// Simulated time after which the robot is put back at its start (s): the tests show it
+/// standing 10 s, so every timed step is of a standing robot.
+const RESTART_AFTER: f64 = 10.0;
+
+fn humanoid(solver_iterations: usize) -> PhysicsSim {
+    let options = SimOptions {
+        root: RootMode::Floating,
+        ground: Some(0.0),
+        gains: PdGains {
+            kp: 8.0,
+            kd: 0.1,
+            max_force: 1.2,
+        },
+        solver_iterations,
+        ..SimOptions::default()
+    };
+    PhysicsSim::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
+}
+
+/// The first pose of the shipped (centred) lift demos: hip-hinge, straight arms.
+fn lift_demo() -> Vec<f64> {
+    let text = std::fs::read_to_string(DEMOS).expect("demo file");
+    let row = text.lines().nth(1).expect("a pose row");
+    row.split(',').map(|v| v.parse().expect("a number")).collect()
+}
+
+fn physics_steps(c: &mut Criterion) {
+    let mut group = c.benchmark_group("humanoid_physics_step");
+    group.throughput(Throughput::Elements(STEPS as u64));
+    let home = vec![0.0; 19];
+    let demo = lift_demo();
+    let settings = [
+        ("home_it4", &home, 4),
+        ("home_it1", &home, 1),
+        ("lift_demo0_it4", &demo, 4),
+    ];
+    for (label, posture, iterations) in settings {
+        let mut sim = humanoid(iterations);
+        let start = |sim: &mut PhysicsSim| {
+            reset_on_ground(sim, posture, "l_foot", 0.0, 5e-4).expect("start posture within limits")
+        };
+        start(&mut sim);
+        group.bench_function(BenchmarkId::from_parameter(label), |b| {
+            b.iter(|| {
+                if sim.time() > RESTART_AFTER {
+                    start(&mut sim);
+                }
+                sim.step(STEPS);
+                black_box(sim.base_pose())
+            })
+        });
+        let height = sim.base_pose().translation.z;
+        assert!(
+            height > 0.09,
+            "{label}: the robot fell during the bench (base {height} m)"
+        );
+    }
+    group.finish();
+}
+
+criterion_group!(benches, physics_steps);
+criterion_main!(benches);
