@@ -107,7 +107,11 @@ impl UrdfModel {
     /// Errors: [`SimError::UnsupportedJointType`] for a joint type other than revolute,
     /// continuous, prismatic or fixed (including unknown type strings) or a mimic joint;
     /// [`SimError::MalformedUrdf`] for bad XML, duplicate names, joints naming missing links,
-    /// a link with two parents, empty or non-finite limits, a moving link without mass;
+    /// a link with two parents, empty or non-finite limits, a moving link without mass, a
+    /// link with mass whose inertia tensor is not positive definite, breaks the triangle
+    /// inequality or has a radius of gyration outside [1 µm, 1 km], non-finite inertial or
+    /// collision poses, negative or non-finite collision sizes, a zero axis, a length or joint
+    /// limit beyond ±1000 (m or rad), or a number too large for rapier's f32 (|value| > 3.4e38);
     /// [`SimError::UnsupportedGeometry`] for mesh collision shapes.
     pub fn parse_named(xml: &str, origin: &str) -> Result<Self> {
         check_joint_types(xml, origin)?;

@@ -99,12 +99,25 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
             i.inertia.ixz,
             i.inertia.iyz,
         ];
-        if values.iter().any(|v| !v.is_finite()) || i.mass.value < 0.0 {
+        let centre = i.origin.xyz.0.iter().chain(i.origin.rpy.0.iter());
+        if values.iter().chain(centre).any(|v| !v.is_finite()) || i.mass.value < 0.0 {
             return Err(bad(format!(
                 "link {:?} has a negative or non-finite <inertial>",
                 link.name
             )));
         }
+        let owner = format!("link {:?}", link.name);
+        check_magnitudes(&owner, link_numbers(link)).map_err(bad)?;
+        check_lengths(&owner, link_lengths(link)).map_err(bad)?;
+        if i.mass.value > 0.0
+            && let Some(problem) = inertia_problem(i.mass.value, &i.inertia)
+        {
+            return Err(bad(format!(
+                "link {:?} has mass {} but its <inertia> {problem}",
+                link.name, i.mass.value
+            )));
+        }
+        check_collisions(link).map_err(bad)?;
     }
     let mut joint_names = HashSet::new();
     let mut children = HashSet::new();
@@ -131,6 +144,9 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
                 origin: origin.to_string(),
             });
         }
+        let owner = format!("joint {:?}", joint.name);
+        check_magnitudes(&owner, joint_numbers(joint)).map_err(bad)?;
+        check_lengths(&owner, joint.origin.xyz.0.map(|v| ("origin xyz", v)).to_vec()).map_err(bad)?;
         let pose = joint.origin.xyz.0.iter().chain(joint.origin.rpy.0.iter());
         if pose.chain(joint.axis.xyz.0.iter()).any(|v| !v.is_finite()) {
             return Err(bad(format!("joint {:?} has a non-finite origin or axis", joint.name)));
@@ -148,13 +164,18 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
                 });
             }
         };
-        if joint.axis.xyz.0.iter().all(|v| *v == 0.0) {
+        // rapier normalises the axis in f32: one too short there becomes zero (silently X).
+        let axis_norm2: f32 = joint.axis.xyz.0.iter().map(|v| (*v as f32) * (*v as f32)).sum();
+        if !axis_norm2.is_normal() {
             return Err(bad(format!("joint {:?} has a zero axis", joint.name)));
         }
         let (lower, upper) = match kind {
             JointKind::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
             _ => (joint.limit.lower, joint.limit.upper),
         };
+        if kind != JointKind::Continuous {
+            check_lengths(&owner, vec![("limit lower", lower), ("limit upper", upper)]).map_err(bad)?;
+        }
         if kind != JointKind::Continuous && !(lower.is_finite() && upper.is_finite() && lower < upper) {
             return Err(bad(format!(
                 "joint {:?} needs <limit lower upper> with lower < upper, got [{lower}, {upper}]",
@@ -183,4 +204,170 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
         });
     }
     Ok(actuated)
+}
+
+/// Largest magnitude rapier's f32 holds: a larger finite f64 becomes ±inf in the physics.
+const F32_MAX: f64 = f32::MAX as f64;
+
+/// Fails on the first finite value whose magnitude does not fit in f32 (non-finite ones
+/// are left to the checks that name them).
+fn check_magnitudes(owner: &str, values: Vec<(&'static str, f64)>) -> std::result::Result<(), String> {
+    match values.iter().find(|(_, v)| v.is_finite() && v.abs() > F32_MAX) {
+        Some((what, v)) => Err(format!(
+            "{owner} has {what} = {v:e}, too large for the f32 physics (|value| <= {F32_MAX:e})"
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Largest length (m) and joint limit (m or rad) accepted: rapier's f32 keeps 0.1 mm at
+/// 1 km, and a joint origin of 1e20 m (m·r² overflowing f32) gave NaN in the first steps.
+const LENGTH_MAX: f64 = 1e3;
+
+/// Fails on the first finite value beyond ±[`LENGTH_MAX`].
+fn check_lengths(owner: &str, values: Vec<(&'static str, f64)>) -> std::result::Result<(), String> {
+    match values.iter().find(|(_, v)| v.is_finite() && v.abs() > LENGTH_MAX) {
+        Some((what, v)) => Err(format!(
+            "{owner} has {what} = {v:e}: lengths and joint limits must lie within ±{LENGTH_MAX} (m or rad)"
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The lengths of a link: inertial and collision origins, collision sizes.
+fn link_lengths(link: &urdf_rs::Link) -> Vec<(&'static str, f64)> {
+    let mut out: Vec<(&'static str, f64)> = link.inertial.origin.xyz.0.map(|v| ("inertial origin", v)).to_vec();
+    for c in &link.collision {
+        out.extend(c.origin.xyz.0.map(|v| ("collision origin", v)));
+        out.extend(geometry_sizes(&c.geometry));
+    }
+    out
+}
+
+/// Every number of a link that reaches rapier: inertial, collision poses and sizes.
+fn link_numbers(link: &urdf_rs::Link) -> Vec<(&'static str, f64)> {
+    let i = &link.inertial;
+    let t = &i.inertia;
+    let mut out = vec![
+        ("mass", i.mass.value),
+        ("ixx", t.ixx),
+        ("iyy", t.iyy),
+        ("izz", t.izz),
+        ("ixy", t.ixy),
+        ("ixz", t.ixz),
+        ("iyz", t.iyz),
+    ];
+    let pose = |name, p: &urdf_rs::Pose| {
+        let xyz = p.xyz.0.map(|v| (name, v));
+        let rpy = p.rpy.0.map(|v| (name, v));
+        xyz.into_iter().chain(rpy)
+    };
+    out.extend(pose("inertial origin", &i.origin));
+    for c in &link.collision {
+        out.extend(pose("collision origin", &c.origin));
+        out.extend(geometry_sizes(&c.geometry));
+    }
+    out
+}
+
+/// Every number of a joint that reaches rapier or the servos.
+fn joint_numbers(joint: &urdf_rs::Joint) -> Vec<(&'static str, f64)> {
+    let l = &joint.limit;
+    let mut out = vec![
+        ("limit lower", l.lower),
+        ("limit upper", l.upper),
+        ("limit effort", l.effort),
+        ("limit velocity", l.velocity),
+    ];
+    out.extend(joint.origin.xyz.0.map(|v| ("origin xyz", v)));
+    out.extend(joint.origin.rpy.0.map(|v| ("origin rpy", v)));
+    out.extend(joint.axis.xyz.0.map(|v| ("axis", v)));
+    if let Some(d) = &joint.dynamics {
+        out.extend([("dynamics damping", d.damping), ("dynamics friction", d.friction)]);
+    }
+    out
+}
+
+/// The sizes of a collision shape (box edges, radii, lengths).
+fn geometry_sizes(g: &urdf_rs::Geometry) -> Vec<(&'static str, f64)> {
+    match g {
+        urdf_rs::Geometry::Box { size } => size.0.map(|v| ("box size", v)).to_vec(),
+        urdf_rs::Geometry::Cylinder { radius, length } | urdf_rs::Geometry::Capsule { radius, length } => {
+            vec![("radius", *radius), ("length", *length)]
+        }
+        urdf_rs::Geometry::Sphere { radius } => vec![("radius", *radius)],
+        urdf_rs::Geometry::Mesh { .. } => Vec::new(),
+    }
+}
+
+/// Collision shapes need finite poses and finite, non-negative sizes.
+fn check_collisions(link: &urdf_rs::Link) -> std::result::Result<(), String> {
+    for c in &link.collision {
+        let mut pose = c.origin.xyz.0.iter().chain(c.origin.rpy.0.iter());
+        if pose.any(|v| !v.is_finite()) {
+            return Err(format!("link {:?} has a non-finite <collision> origin", link.name));
+        }
+        if let Some((what, v)) = geometry_sizes(&c.geometry)
+            .into_iter()
+            .find(|(_, v)| !(v.is_finite() && *v >= 0.0))
+        {
+            return Err(format!(
+                "link {:?} has a <collision> {what} of {v}: sizes must be finite and >= 0",
+                link.name
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Smallest radius of gyration (m) a link with mass may have about any axis: below it the
+/// f32 multibody mass matrix is numerically singular (a principal moment of 1e-20 kg·m²
+/// on a 40 g link of the humanoid gave NaN). The largest is [`LENGTH_MAX`].
+const MIN_GYRATION_RADIUS: f64 = 1e-6;
+
+/// Slack on the triangle inequality of the principal moments, for rounded values in files.
+const TRIANGLE_SLACK: f64 = 1e-2;
+
+/// Why the inertia tensor of a link with `mass` > 0 cannot be simulated, or `None`.
+///
+/// It must be positive definite as rapier sees it (Sylvester's criterion on the values
+/// narrowed to f32, diagonal normal in f32), have every principal moment at least
+/// `mass · MIN_GYRATION_RADIUS²` and at most `mass · LENGTH_MAX²`, and satisfy the triangle inequality of a rigid body
+/// (each principal moment at most the sum of the other two, within `TRIANGLE_SLACK`).
+/// A zero, singular or unphysical tensor makes the multibody mass matrix singular or so
+/// ill-conditioned in f32 that the first steps give NaN, and the next one panics in rapier.
+fn inertia_problem(mass: f64, t: &urdf_rs::Inertia) -> Option<String> {
+    let f = |v: f64| f64::from(v as f32);
+    let (xx, yy, zz, xy, xz, yz) = (f(t.ixx), f(t.iyy), f(t.izz), f(t.ixy), f(t.ixz), f(t.iyz));
+    let diagonal = [xx, yy, zz].iter().all(|v| *v > 0.0 && (*v as f32).is_normal());
+    let minor2 = xx * yy - xy * xy;
+    let det = xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+    if !(diagonal && minor2 > 0.0 && det > 0.0 && (mass as f32).is_normal()) {
+        return Some("is not positive definite (in f32)".to_string());
+    }
+    let matrix = nalgebra::Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+    let mut moments: Vec<f64> = matrix.symmetric_eigenvalues().iter().copied().collect();
+    moments.sort_by(f64::total_cmp);
+    let floor = mass * MIN_GYRATION_RADIUS * MIN_GYRATION_RADIUS;
+    if moments[0] < floor {
+        return Some(format!(
+            "has a principal moment {:e} below mass x (1 um)^2 = {floor:e} kg m^2",
+            moments[0]
+        ));
+    }
+    let ceiling = mass * LENGTH_MAX * LENGTH_MAX;
+    if moments[2] > ceiling {
+        return Some(format!(
+            "has a principal moment {:e} above mass x (1 km)^2 = {ceiling:e} kg m^2",
+            moments[2]
+        ));
+    }
+    if moments[2] > (moments[0] + moments[1]) * (1.0 + TRIANGLE_SLACK) {
+        return Some(format!(
+            "breaks the triangle inequality: principal moments {:e}, {:e}, {:e} \
+             (the largest may not exceed the sum of the other two)",
+            moments[0], moments[1], moments[2]
+        ));
+    }
+    None
 }
