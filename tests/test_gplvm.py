@@ -195,7 +195,7 @@ def test_load_rejects_bad_files(tmp_path, model):
     [
         (np.ones((2, 3)), {}, "n_samples=2 must be greater than n_components=2"),
         (np.ones((5, 1)), {}, "n_features=1 must be at least n_components=2"),
-        (np.array([[0.0, np.nan, 1.0]] * 4), {}, r"X: non-finite value nan at index \(0, 1\)"),
+        (np.array([[0.0, np.nan, 1.0]] * 4), {}, r"X: non-finite value NaN at index \(0, 1\)"),
         (np.array([[0.0, 1.0, -np.inf]] * 4), {}, "X: non-finite value -inf"),
         (manifold(), {"max_iter": 0}, "max_iter must be an int >= 1"),
         (manifold(), {"n_restarts": -1}, "n_restarts must be an int >= 0"),
@@ -210,11 +210,11 @@ def test_bad_fit_input(X, params, match):
 
 
 def test_bad_use_after_fit(model):
-    with pytest.raises(ValueError, match="X: expected 5 columns"):
+    with pytest.raises(ValueError, match="X has 4 features, but GPLVM is expecting 5 features"):
         model.transform(np.ones((2, 4)))
     with pytest.raises(ValueError, match="Z: expected 2 columns"):
         model.inverse_transform(np.ones((2, 3)))
-    with pytest.raises(ValueError, match=r"Z: non-finite value nan at index \(1, 0\)"):
+    with pytest.raises(ValueError, match=r"Z: non-finite value NaN at index \(1, 0\)"):
         model.predict_variance(np.array([[0.0, 0.0], [np.nan, 0.0]]))
     with pytest.raises(ValueError, match="encoder method must be one of"):
         model.transform(np.ones((2, 5)), method="pca")

@@ -58,7 +58,7 @@ def test_constant_data_fits():
         (np.ones((5, 1)), {}, "n_features=1 must be at least n_components=2"),
         (np.ones((5, 3)), {"n_components": 0}, "n_components must be an int"),
         (np.ones((5, 3)), {"n_components": 1.5}, "n_components must be an int"),
-        (np.array([[0.0, np.nan, 1.0]] * 4), {}, r"X: non-finite value nan at index \(0, 1\)"),
+        (np.array([[0.0, np.nan, 1.0]] * 4), {}, r"X: non-finite value NaN at index \(0, 1\)"),
         (np.array([[0.0, np.inf, 1.0]] * 4), {}, "X: non-finite value inf"),
         (np.ones(5), {}, "X: expected a 2-D array"),
     ],
@@ -70,7 +70,7 @@ def test_bad_fit_input(X, params, match):
 
 def test_bad_transform_input():
     pca = PCA().fit(data())
-    with pytest.raises(ValueError, match="X: expected 5 columns"):
+    with pytest.raises(ValueError, match="X has 4 features, but PCA is expecting 5 features"):
         pca.transform(np.ones((2, 4)))
     with pytest.raises(ValueError, match="Z: expected 2 columns"):
         pca.inverse_transform(np.ones((2, 3)))

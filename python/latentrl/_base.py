@@ -1,5 +1,6 @@
-"""Shared machinery of the estimators: parameters, persistence, atomic writes and the
-L-BFGS fit of a GP's marginal likelihood (used by the GPLVM and the GP encoder)."""
+"""Shared machinery of the estimators: parameters, input and column-name checks, the
+scikit-learn protocol, persistence, atomic writes and the L-BFGS fit of a GP's marginal
+likelihood (used by the GPLVM and the GP encoder)."""
 
 from __future__ import annotations
 
@@ -7,12 +8,13 @@ import inspect
 import json
 import os
 import uuid
+import warnings
 import zipfile
 import zlib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Any, ClassVar
+from typing import IO, Any, ClassVar, Self
 
 import numpy as np
 from numpy.typing import NDArray
@@ -20,6 +22,7 @@ from scipy.optimize import minimize
 from scipy.spatial.distance import pdist
 
 from latentrl._native import LatentrlError, gplvm_nll_grad
+from latentrl._validation import as_matrix
 
 #: Version of the NPZ layout written by `Estimator.save`; `load` refuses any other.
 FORMAT_VERSION = 1
@@ -34,10 +37,11 @@ class NotFittedError(LatentrlError, AttributeError):
     """An estimator used before `fit`: a ValueError and an AttributeError, as in scikit-learn."""
 
 
-def atomic_write(path: PathLike, write: Callable[[IO[bytes]], None]) -> None:
-    """Calls `write` on a temporary file beside `path` (creating missing parent directories),
-    flushes it to disk, then renames it over `path`, so an interrupted write never leaves a
-    half-written file. A process killed mid-write leaves only `.{name}.<hex>.tmp` behind."""
+def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
+    """Calls `write` (its result is ignored) on a temporary file beside `path` (creating
+    missing parent directories), flushes it to disk, then renames it over `path`, so an
+    interrupted write never leaves a half-written file. A process killed mid-write leaves
+    only `.{name}.<hex>.tmp` behind."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
@@ -66,17 +70,103 @@ def read_npz(path: PathLike) -> dict[str, NDArray[Any]]:
             raise ValueError(f"not a readable NPZ file (corrupt or truncated?): {err}") from err
 
 
+def column_names(X: Any) -> NDArray[np.object_] | None:
+    """The column names of a DataFrame `X` (pandas, or anything with ``columns``) as an
+    object array, if they are all strings; None for other inputs and for non-string names
+    (pandas' default 0, 1, …), as scikit-learn. Mixed string and other names: TypeError."""
+    columns = getattr(X, "columns", None)
+    if columns is None or isinstance(X, np.ndarray):
+        return None
+    names = np.asarray(list(columns), dtype=object)
+    is_str = [isinstance(name, str) for name in names]
+    if not any(is_str):
+        return None
+    if not all(is_str):
+        types = sorted({type(name).__name__ for name in names})
+        raise TypeError(
+            f"X: column names must all be strings to be recorded, got types {types}; "
+            "convert them (X.columns = X.columns.astype(str))"
+        )
+    return names
+
+
+def check_feature_names(estimator: Any, names: NDArray[np.object_] | None) -> None:
+    """Compares the column names `names` of a transform's input with the
+    `feature_names_in_` that `estimator` was fitted with: a ValueError listing the unseen,
+    the missing, or (same set) the expected order; a UserWarning if only one side has names.
+    The first line is scikit-learn's, which its checks match."""
+    fitted = getattr(estimator, "feature_names_in_", None)
+    cls = type(estimator).__name__
+    if names is None or fitted is None:
+        if names is not None:
+            warnings.warn(
+                f"X has feature names, but {cls} was fitted without feature names", stacklevel=4
+            )
+        elif fitted is not None:
+            warnings.warn(
+                f"X does not have valid feature names, but {cls} was fitted with feature names",
+                stacklevel=4,
+            )
+        return
+    if len(names) == len(fitted) and np.all(names == fitted):
+        return
+    unseen = sorted(set(names) - set(fitted))
+    missing = sorted(set(fitted) - set(names))
+    message = "The feature names should match those that were passed during fit.\n"
+    if unseen:
+        message += "Feature names unseen at fit time:\n" + "".join(f"- {n}\n" for n in unseen)
+    if missing:
+        message += "Feature names seen at fit time, yet now missing:\n" + "".join(
+            f"- {n}\n" for n in missing
+        )
+    if not unseen and not missing:
+        message += "Feature names must be in the same order as they were in fit.\n"
+    message += f"{cls} was fitted with the columns {list(fitted)}; X has {list(names)}"
+    raise ValueError(message)
+
+
 class Estimator:
     """scikit-learn's estimator contract without depending on it: `__init__` only stores
-    its parameters; `get_params`/`set_params`, `__repr__`, pickling and NPZ save/load.
+    its parameters; `get_params`/`set_params`, `__repr__`, pickling and NPZ save/load; the
+    input checks of `fit` and `transform`, column names of pandas DataFrames
+    (`feature_names_in_`), `get_feature_names_out`, and the hooks scikit-learn's tools look
+    for (`__sklearn_tags__`, `__sklearn_is_fitted__`), so that `clone`, `Pipeline` and
+    `GridSearchCV` take it as one of theirs.
 
     Subclasses list in `_saved` every fitted attribute that `save` writes, mapped to its
     dtype kind and shape: an int is an exact size, ``"d"`` is `n_components`, ``"D"`` is
     `n_features_in_`, any other symbol (``"N"``) must agree across arrays. `_build` derives
     the rest of the fitted state from those attributes after `fit` and after `load`.
+    `feature_names_in_`, set only when `fit` saw column names, is saved and pickled too.
     """
 
     _saved: ClassVar[SavedSpec] = {}
+
+    #: Fitted attributes (see `fit`); declared for type checkers.
+    n_components: int
+    n_features_in_: int
+    feature_names_in_: NDArray[np.object_]
+
+    def fit(self, X: Any, y: Any = None) -> Self:
+        """Fits the model to postures `X` (N, D); returns self."""
+        raise NotImplementedError
+
+    def transform(self, X: Any) -> NDArray[np.float64]:
+        """Latent points (M, d) of postures `X` (M, D)."""
+        raise NotImplementedError
+
+    def fit_transform(self, X: Any, y: Any = None) -> NDArray[np.float64]:
+        """Latent points (N, d) of the postures `X` (N, D) it is fitted to."""
+        raise NotImplementedError
+
+    def inverse_transform(self, Z: Any) -> NDArray[np.float64]:
+        """Postures (M, D) decoded from latent points `Z` (M, d)."""
+        raise NotImplementedError
+
+    @property
+    def _n_features_out(self) -> int:
+        """Latent dimension of the fitted model."""
+        raise NotImplementedError
 
     @classmethod
     def _param_names(cls) -> list[str]:
@@ -87,7 +177,7 @@ class Estimator:
         """The constructor's parameters as a dict."""
         return {name: getattr(self, name) for name in self._param_names()}
 
-    def set_params(self, **params: Any) -> Estimator:
+    def set_params(self, **params: Any) -> Self:
         """Sets constructor parameters; returns self."""
         valid = self._param_names()
         for name, value in params.items():
@@ -106,16 +196,79 @@ class Estimator:
     def _build(self) -> None:
         """Derives the fitted state that is not saved (native maps, aliases)."""
 
+    def __sklearn_is_fitted__(self) -> bool:
+        """Whether `fit` (or `load`) has set the fitted state (scikit-learn's hook)."""
+        return all(hasattr(self, name) for name in self._saved)
+
+    def __sklearn_tags__(self) -> Any:
+        """scikit-learn's tags: an unsupervised transformer of dense float64 matrices
+        without NaN. Only scikit-learn calls this, so it is imported here, not by latentrl."""
+        from sklearn.utils import InputTags, Tags, TargetTags, TransformerTags
+
+        return Tags(
+            estimator_type=None,
+            target_tags=TargetTags(required=False),
+            transformer_tags=TransformerTags(preserves_dtype=["float64"]),
+            input_tags=InputTags(two_d_array=True, sparse=False, allow_nan=False),
+        )
+
     def _check_fitted(self) -> None:
-        if not all(hasattr(self, name) for name in self._saved):
+        if not self.__sklearn_is_fitted__():
             raise NotFittedError(f"this {type(self).__name__} is not fitted yet: call fit(X) first")
 
+    def _check_X(self, X: Any) -> NDArray[np.float64]:
+        """Postures `X` for a fitted model, as a float64 matrix: a DataFrame's columns must
+        be `feature_names_in_` in the same order (a ValueError naming the unseen, missing
+        or misplaced ones); a UserWarning if only one of `fit` and `X` had column names (as
+        scikit-learn); then `n_features_in_` columns."""
+        self._check_fitted()
+        check_feature_names(self, column_names(X))
+        matrix = as_matrix("X", X)
+        if matrix.shape[1] != self.n_features_in_:
+            raise ValueError(
+                f"X has {matrix.shape[1]} features, but {type(self).__name__} is expecting "
+                f"{self.n_features_in_} features as input (got shape {matrix.shape})"
+            )
+        return matrix
+
+    def _set_feature_names(self, names: NDArray[np.object_] | None) -> None:
+        """Records the column names `fit` saw, or forgets those of an earlier fit."""
+        if names is not None:
+            self.feature_names_in_ = names
+        elif hasattr(self, "feature_names_in_"):
+            del self.feature_names_in_
+
+    def get_feature_names_out(self, input_features: Any = None) -> NDArray[np.object_]:
+        """Names of the latent axes, ``"<class>0"``, ``"<class>1"``, … (``pca0``,
+        ``gplvm1``), as scikit-learn names the outputs of its decompositions.
+        `input_features`, if given, must be `feature_names_in_` (or any D names if `fit`
+        saw none)."""
+        self._check_fitted()
+        if input_features is not None:
+            given = np.asarray(input_features, dtype=object)
+            fitted = getattr(self, "feature_names_in_", None)
+            if fitted is not None and not np.array_equal(given, fitted):
+                raise ValueError(
+                    "input_features is not equal to feature_names_in_: "
+                    f"{list(given)} != {list(fitted)}"
+                )
+            if given.ndim != 1 or len(given) != self.n_features_in_:
+                raise ValueError(
+                    "input_features should have length equal to number of features "
+                    f"({self.n_features_in_}), got {len(given)}"
+                )
+        prefix = type(self).__name__.lower()
+        return np.array([f"{prefix}{i}" for i in range(self._n_features_out)], dtype=object)
+
     def _fitted_state(self) -> dict[str, Any]:
-        return {name: getattr(self, name) for name in self._saved}
+        state = {name: getattr(self, name) for name in self._saved}
+        if hasattr(self, "feature_names_in_"):
+            state["feature_names_in_"] = self.feature_names_in_
+        return state
 
     def _restore(self, state: dict[str, Any]) -> None:
         """Sets the saved attributes after checking them against `_saved`, then `_build`s."""
-        sizes = {"d": self.n_components}  # type: ignore[attr-defined]
+        sizes = {"d": self.n_components}
         if "n_features_in_" in state:
             sizes["D"] = int(state["n_features_in_"])
         for name, (kind, shape) in self._saved.items():
@@ -132,6 +285,14 @@ class Estimator:
                 if size != expected:
                     raise ValueError(f"{name}: axis {symbol} has size {size}, expected {expected}")
             setattr(self, name, value.item() if value.ndim == 0 else value)
+        names = state.get("feature_names_in_")
+        if names is not None:
+            names = np.asarray(names, dtype=object)
+            if names.shape != (sizes["D"],) or not all(isinstance(n, str) for n in names):
+                raise ValueError(
+                    f"feature_names_in_: expected {sizes['D']} strings, got {names!r}"
+                )
+        self._set_feature_names(names)
         self._build()
 
     def __getstate__(self) -> dict[str, Any]:
@@ -160,10 +321,12 @@ class Estimator:
             "params": np.array(params),
             **{name: np.asarray(value) for name, value in self._fitted_state().items()},
         }
+        if "feature_names_in_" in arrays:  # strings, not objects: `load` reads no pickles
+            arrays["feature_names_in_"] = arrays["feature_names_in_"].astype(str)
         atomic_write(path, lambda fh: np.savez(fh, **arrays))
 
     @classmethod
-    def load(cls, path: PathLike) -> Any:
+    def load(cls, path: PathLike) -> Self:
         """Reads an estimator written by `save`. A corrupt, truncated or mismatched file is a
         ValueError saying what is wrong."""
         try:

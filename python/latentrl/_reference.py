@@ -13,12 +13,14 @@ Array = NDArray[np.float64]
 def se_kernel(a: Array, b: Array, theta: Array) -> Array:
     """`θ1 exp(−‖a_i − b_j‖² / (2 θ2))` between the rows of `a` (N, q) and `b` (M, q): (N, M)."""
     r2 = np.sum((a[:, None, :] - b[None, :, :]) ** 2, axis=-1)
-    return theta[0] * np.exp(-0.5 * r2 / theta[1])
+    k: Array = theta[0] * np.exp(-0.5 * r2 / theta[1])
+    return k
 
 
 def kernel_matrix(points: Array, theta: Array) -> Array:
     """`K` of Eq. 2 over the rows of `points`: SE part plus `θ3 I`."""
-    return se_kernel(points, points, theta) + theta[2] * np.eye(len(points))
+    k: Array = se_kernel(points, points, theta) + theta[2] * np.eye(len(points))
+    return k
 
 
 def gp_predict(inputs: Array, outputs: Array, theta: Array, queries: Array) -> tuple[Array, Array]:
@@ -64,7 +66,8 @@ def rbf_centres(low: Array, high: Array, per_dim: int) -> tuple[Array, Array]:
 def rbf_features(state: Array, centres: Array, sigma: Array) -> Array:
     """Dense normalised RBFs `b_i = φ_i / Σ_j φ_j`, `φ_i = exp(−½ Σ_k ((s_k − c_ik)/σ_k)²)`."""
     phi = np.exp(-0.5 * np.sum(((state - centres) / sigma) ** 2, axis=-1))
-    return phi / phi.sum()
+    features: Array = phi / phi.sum()
+    return features
 
 
 def td0_update(weights: Array, b: Array, reward: float, v_next: float, alpha: float, gamma: float) -> float:

@@ -6,6 +6,12 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.sparse import issparse
+
+
+class ComplexDataError(TypeError, ValueError):
+    """Complex values where real numbers are expected: a TypeError (a wrong dtype, as
+    latentrl has always raised) and a ValueError (what scikit-learn raises and checks)."""
 
 
 def as_matrix(
@@ -14,13 +20,24 @@ def as_matrix(
     """`value` as a C-ordered float64 (rows, cols) array, or a ValueError/TypeError saying why not."""
     array = _floats(name, value, "a 2-D array")
     if array.ndim != 2:
-        raise ValueError(f"{name}: expected a 2-D array (rows, columns), got shape {array.shape}")
+        hint = (
+            f". Reshape your data: {name}.reshape(1, -1) if it is one row, "
+            f"{name}.reshape(-1, 1) if it is one column"
+            if array.ndim == 1
+            else ""
+        )
+        raise ValueError(
+            f"{name}: expected a 2-D array (rows, columns), got shape {array.shape}{hint}"
+        )
     if n_cols is not None and array.shape[1] != n_cols:
         raise ValueError(f"{name}: expected {n_cols} columns, got shape {array.shape}")
     if array.shape[0] < min_rows:
         raise ValueError(f"{name}: expected at least {min_rows} rows, got shape {array.shape}")
     if array.shape[1] == 0:
-        raise ValueError(f"{name}: has no columns, shape {array.shape}")
+        # scikit-learn's wording: its estimator checks match it.
+        raise ValueError(
+            f"{name}: 0 feature(s) (shape={array.shape}) while a minimum of 1 is required."
+        )
     check_finite(name, array)
     return np.ascontiguousarray(array)
 
@@ -38,13 +55,30 @@ def as_vector(name: str, value: Any, *, length: int | None = None) -> NDArray[np
 
 def _floats(name: str, value: Any, expected: str) -> NDArray[np.float64]:
     """`value` as a float64 array, or a TypeError naming `name` and what was `expected`
-    (complex values too: casting would silently drop their imaginary parts)."""
-    if np.iscomplexobj(value):
-        raise TypeError(f"{name}: expected {expected} of real numbers, got complex values")
+    (a sparse matrix too; complex values too, as a `ComplexDataError`: casting would
+    silently drop their imaginary parts)."""
+    if issparse(value):
+        raise TypeError(
+            f"{name}: sparse input is not supported, expected {expected} "
+            f"(densify it: {name}.toarray())"
+        )
+
+    def not_numbers(err: Exception) -> TypeError:
+        got = type(value).__name__
+        return TypeError(f"{name}: expected {expected} of numbers, got {got} ({err})")
+
     try:
-        return np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as err:
-        raise TypeError(f"{name}: expected {expected} of numbers, got {type(value).__name__}") from err
+        array = np.asarray(value)
+    except (TypeError, ValueError) as err:  # ragged nested lists
+        raise not_numbers(err) from err
+    if array.dtype.kind == "c":
+        raise ComplexDataError(
+            f"{name}: Complex data not supported, expected {expected} of real numbers"
+        )
+    try:
+        return array.astype(np.float64, copy=False)
+    except (TypeError, ValueError) as err:  # strings, objects
+        raise not_numbers(err) from err
 
 
 def check_finite(name: str, array: NDArray[np.float64]) -> None:
@@ -52,7 +86,8 @@ def check_finite(name: str, array: NDArray[np.float64]) -> None:
     bad = np.argwhere(~np.isfinite(array))
     if bad.size:
         index = tuple(int(i) for i in bad[0])
-        raise ValueError(f"{name}: non-finite value {array[index]} at index {index}")
+        value = "NaN" if np.isnan(array[index]) else array[index]
+        raise ValueError(f"{name}: non-finite value {value} at index {index}")
 
 
 def positive(name: str, value: float) -> float:

@@ -175,8 +175,11 @@ def grip_error(
     """
     hands = as_matrix("hands", hands, n_cols=4)
     diff = hands[:, 2:] - hands[:, :2]
+    error: NDArray[np.float64]
     if test == "distance":
-        return np.abs(np.linalg.norm(diff, axis=1) - np.linalg.norm(OFFSET))
+        error = np.abs(np.linalg.norm(diff, axis=1) - np.linalg.norm(OFFSET))
+        return error
     if test == "vector":
-        return np.linalg.norm(diff - OFFSET, axis=1)
+        error = np.linalg.norm(diff - OFFSET, axis=1)
+        return error
     raise ValueError(f"test must be 'distance' or 'vector', got {test!r}")

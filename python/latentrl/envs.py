@@ -124,6 +124,8 @@ class BimanualReachEnv(gym.Env[Obs, Obs]):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Obs, dict[str, Any]]:
+        """Starts an episode near the default grip (seeded by `seed`), or at
+        ``options["posture"]``; returns the observation and an empty info dict."""
         super().reset(seed=seed)
         posture = _posture_option(options)
         if posture is None:
@@ -143,6 +145,9 @@ class BimanualReachEnv(gym.Env[Obs, Obs]):
         return None
 
     def step(self, action: Obs) -> tuple[Obs, SupportsFloat, bool, bool, dict[str, Any]]:
+        """Moves the joints by `action` (clipped to ±`max_step`); returns observation,
+        reward, terminated (obstacle, box exit or drop), truncated (never) and info
+        (``end_reason``, ``reached``)."""
         delta = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
         self.posture = self.posture + delta
         reward = float(np.exp(-self.theta * np.sum((self.posture - self.target) ** 2)))
@@ -154,6 +159,8 @@ class BimanualReachEnv(gym.Env[Obs, Obs]):
         return self.posture.copy(), reward, reason is not None, False, info
 
     def render(self) -> NDArray[np.uint8] | None:
+        """An RGB image (H, W, 3) of the arms, target and obstacles if `render_mode` is
+        ``"rgb_array"``, else None."""
         if self.render_mode != "rgb_array":
             return None
         from matplotlib.patches import Circle
@@ -256,6 +263,8 @@ class TwoArmsEnv(gym.Env[Obs, Obs]):
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Obs, dict[str, Any]]:
+        """Starts an episode near the default grip (seeded by `seed`), or at
+        ``options["posture"]``; returns the observation and an empty info dict."""
         super().reset(seed=seed)
         posture = _posture_option(options)
         if posture is None:
@@ -273,6 +282,9 @@ class TwoArmsEnv(gym.Env[Obs, Obs]):
         return None
 
     def step(self, action: Obs) -> tuple[Obs, SupportsFloat, bool, bool, dict[str, Any]]:
+        """Sets the servo targets to the posture plus `action` (clipped to ±`max_step`) and
+        runs the physics sub-steps; returns observation, reward, terminated (obstacle or
+        drop), truncated (never) and info (``end_reason``, ``reached``)."""
         delta = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
         self.sim.set_targets(self.posture + delta)
         self.sim.step()
@@ -287,6 +299,8 @@ class TwoArmsEnv(gym.Env[Obs, Obs]):
         return obs, reward, reason is not None, False, info
 
     def render(self) -> NDArray[np.uint8] | None:
+        """An RGB image (H, W, 3) of the arms, target and obstacles if `render_mode` is
+        ``"rgb_array"``, else None."""
         if self.render_mode != "rgb_array":
             return None
         from matplotlib.patches import Rectangle
@@ -384,11 +398,16 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[Obs, dict[str, Any]]:
+        """Resets the wrapped env and returns the encoded latent point of its posture."""
         _, info = self.env.reset(seed=seed, options=options)
         self.z = self._encode()
         return self.z.copy(), info
 
     def step(self, action: Obs) -> tuple[Obs, SupportsFloat, bool, bool, dict[str, Any]]:
+        """Moves the latent point by `action` (clipped to ±`max_step`), decodes it and steps
+        the wrapped env towards that posture. A target outside the latent box, or above
+        `variance_threshold`, ends the episode with the penalty instead (``end_reason``
+        ``"box_exit"`` / ``"gated"``)."""
         u = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
         target_z = self.z + u
         refused = None

@@ -3,12 +3,12 @@ decodes to the demonstrated postures, with two inverse maps to encode."""
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Self
 
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import Estimator, SavedSpec, initial_log_theta, minimise_nll
+from latentrl._base import Estimator, SavedSpec, column_names, initial_log_theta, minimise_nll
 from latentrl._native import GpMap
 from latentrl._validation import as_matrix, positive
 from latentrl.inverse import Projection, fit_gp_encoder
@@ -90,6 +90,25 @@ class GPLVM(Estimator):
         Posture → Z by iterative projection.
     n_features_in_ : int
         Number of joints D.
+    feature_names_in_ : ndarray (D,) of str objects
+        The joint names: the column names of a pandas DataFrame passed to `fit`, if they
+        are all strings (not set otherwise).
+
+    Notes
+    -----
+    A scikit-learn transformer, without depending on scikit-learn: it works in
+    `Pipeline`, `clone` and `GridSearchCV`, and passes scikit-learn's
+    `parametrize_with_checks` (tests/test_sklearn.py) but for two checks that may fail by
+    design, `check_transformer_general` and `check_transformer_data_not_an_array`: they
+    want `fit_transform(X)` to equal `transform(X)` within 1e-2, but `fit_transform`
+    returns the fitted latent points `Z_` while `transform` encodes with the GP encoder, a
+    smooth regression onto `Z_` that only approximates them (how closely depends on the
+    data and on where L-BFGS leaves `Z_`).
+    `X` may be a pandas DataFrame: `transform` then wants the columns of `fit` in the same
+    order, and raises a ValueError naming the unseen, missing or misplaced ones (it warns
+    if only one of the two had column names). `transform`, `inverse_transform` and
+    `predict_variance` return ndarrays, `inverse_transform`'s columns in the order of
+    `feature_names_in_`; `get_feature_names_out` names the latent axes ``gplvm0``, …
     """
 
     _saved: ClassVar[SavedSpec] = {
@@ -126,8 +145,10 @@ class GPLVM(Estimator):
         self.encoder = encoder
         self.tol = tol
 
-    def fit(self, X: Any, y: Any = None) -> GPLVM:
-        """Fits the latent points and kernel to postures `X` (N, D); returns self."""
+    def fit(self, X: Any, y: Any = None) -> Self:
+        """Fits the latent points and kernel to postures `X` (N, D), an array or DataFrame;
+        `y` is ignored. Returns self."""
+        names = column_names(X)
         X = as_matrix("X", X)
         check_n_components(self.n_components, X)
         max_iter = _check_int("max_iter", self.max_iter, 1)
@@ -160,6 +181,7 @@ class GPLVM(Estimator):
         best = min(fits, key=lambda fit: fit.nll)
 
         self.n_features_in_ = X.shape[1]
+        self._set_feature_names(names)
         self.mean_ = pca.mean_
         self.X_train_ = X.copy()
         self.Z_ = best.latent
@@ -185,25 +207,31 @@ class GPLVM(Estimator):
         if method not in ENCODERS:
             raise ValueError(f"encoder method must be one of {ENCODERS}, got {method!r}")
 
+    @property
+    def _n_features_out(self) -> int:
+        return int(self.Z_.shape[1])
+
     def fit_transform(self, X: Any, y: Any = None) -> NDArray[np.float64]:
         """`fit(X)`, then the fitted latent points `Z_` (not re-encoded)."""
         return self.fit(X).Z_
 
     def transform(self, X: Any, method: str | None = None) -> NDArray[np.float64]:
-        """Encodes postures `X` (M, D) to latent points (M, d), with the out-of-sample GP
-        (`method="gp"`) or the iterative projection; default: the `encoder` parameter."""
+        """Encodes postures `X` (M, D), an array or DataFrame, to latent points (M, d),
+        with the out-of-sample GP (`method="gp"`) or the iterative projection; default: the
+        `encoder` parameter."""
         self._check_fitted()
         method = self.encoder if method is None else method
         self._check_encoder(method)
-        X = as_matrix("X", X, n_cols=self.n_features_in_)
+        X = self._check_X(X)
         return self.encoder_.predict_mean(X) if method == "gp" else self.projection_.encode(X)
 
     def inverse_transform(self, Z: Any) -> NDArray[np.float64]:
-        """Decodes latent points `Z` (M, d) to postures (M, D): the GP mean (Eq. 4)."""
+        """Decodes latent points `Z` (M, d) to postures (M, D): the GP mean (Eq. 4), an
+        ndarray, its columns in the order of `feature_names_in_`."""
         self._check_fitted()
-        return self.decoder_.predict_mean(as_matrix("Z", Z, n_cols=self.n_components))
+        return self.decoder_.predict_mean(as_matrix("Z", Z, n_cols=self._n_features_out))
 
     def predict_variance(self, Z: Any) -> NDArray[np.float64]:
         """Predictive variance σ²(z) (M,) at latent points `Z` (M, d), θ3 included (Eq. 4)."""
         self._check_fitted()
-        return self.decoder_.predict(as_matrix("Z", Z, n_cols=self.n_components))[1]
+        return self.decoder_.predict(as_matrix("Z", Z, n_cols=self._n_features_out))[1]

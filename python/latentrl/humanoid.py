@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
+from typing import TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
@@ -25,10 +26,27 @@ from latentrl import _native
 
 #: Width of the lifted object: the demonstrated hand distance (m).
 GRIP_WIDTH = 0.10
+
+
+class ServoGains(TypedDict):
+    """PD servo of every joint: keyword arguments of `Sim` and the fall check."""
+
+    kp: float
+    kd: float
+    max_force: float
+
+
+class PhysicsSettings(TypedDict):
+    """Physics step (s) and solver iterations: keyword arguments of `Sim` and the fall check."""
+
+    dt: float
+    solver_iterations: int
+
+
 #: Servo of the humanoid (SPEC §4.3's MuJoCo study): kp N·m/rad, kd N·m·s/rad, cap N·m.
-SERVO = {"kp": 8.0, "kd": 0.1, "max_force": 1.2}
+SERVO: ServoGains = {"kp": 8.0, "kd": 0.1, "max_force": 1.2}
 #: Physics step (s) and solver iterations of the fall check (10 s stand test passes).
-PHYSICS = {"dt": 1.0 / 240.0, "solver_iterations": 4}
+PHYSICS: PhysicsSettings = {"dt": 1.0 / 240.0, "solver_iterations": 4}
 
 
 def urdf_path() -> Path:
@@ -47,13 +65,23 @@ def _rpy(r: float, p: float, y: float) -> NDArray[np.float64]:
     rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
     ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
     rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
-    return rz @ ry @ rx
+    rotation: NDArray[np.float64] = rz @ ry @ rx
+    return rotation
 
 
 def _axis_angle(axis: NDArray[np.float64], q: float) -> NDArray[np.float64]:
     a = axis / np.linalg.norm(axis)
     k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-    return np.eye(3) + np.sin(q) * k + (1 - np.cos(q)) * k @ k
+    rotation: NDArray[np.float64] = np.eye(3) + np.sin(q) * k + (1 - np.cos(q)) * k @ k
+    return rotation
+
+
+def _attr(element: ET.Element | None, key: str, what: str) -> str:
+    """Attribute `key` of `element`; a ValueError naming `what` if either is missing."""
+    value = None if element is None else element.get(key)
+    if value is None:
+        raise ValueError(f"URDF: {what} has no {key!r} attribute")
+    return value
 
 
 def _pose(origin: ET.Element | None) -> NDArray[np.float64]:
@@ -78,38 +106,46 @@ class Humanoid:
 
     @classmethod
     def from_urdf(cls, path: str | Path | None = None) -> Humanoid:
-        """Reads the URDF at `path` (default: the shipped robot)."""
+        """Reads the URDF at `path` (default: the shipped robot); a missing element or
+        attribute is a ValueError naming it."""
         tree = ET.parse(path or urdf_path()).getroot()
-        joints, names, lower, upper = [], [], [], []
+        joints: list[tuple[str, str, str, NDArray[np.float64], NDArray[np.float64] | None]] = []
+        names: list[str] = []
+        lower: list[float] = []
+        upper: list[float] = []
         for j in tree.findall("joint"):
-            parent = j.find("parent").get("link")  # type: ignore[union-attr]
-            child = j.find("child").get("link")  # type: ignore[union-attr]
+            name = _attr(j, "name", "a <joint>")
+            parent = _attr(j.find("parent"), "link", f"the <parent> of joint {name!r}")
+            child = _attr(j.find("child"), "link", f"the <child> of joint {name!r}")
             axis = None
             if j.get("type") != "fixed":
                 axis_el = j.find("axis")
                 xyz = axis_el.get("xyz", "1 0 0") if axis_el is not None else "1 0 0"
                 axis = np.array([float(v) for v in xyz.split()])
                 lim = j.find("limit")
-                names.append(j.get("name"))
-                lower.append(float(lim.get("lower")))  # type: ignore[union-attr]
-                upper.append(float(lim.get("upper")))  # type: ignore[union-attr]
-            joints.append((j.get("name"), parent, child, _pose(j.find("origin")), axis))
-        inertials, boxes = [], {}
+                names.append(name)
+                lower.append(float(_attr(lim, "lower", f"the <limit> of joint {name!r}")))
+                upper.append(float(_attr(lim, "upper", f"the <limit> of joint {name!r}")))
+            joints.append((name, parent, child, _pose(j.find("origin")), axis))
+        inertials: list[tuple[str, float, NDArray[np.float64]]] = []
+        boxes: dict[str, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
         for link in tree.findall("link"):
+            link_name = _attr(link, "name", "a <link>")
             inertial = link.find("inertial")
             if inertial is not None:
-                mass = float(inertial.find("mass").get("value"))  # type: ignore[union-attr]
+                mass = float(_attr(inertial.find("mass"), "value", f"the mass of {link_name!r}"))
                 centre = _pose(inertial.find("origin"))[:3, 3]
-                inertials.append((link.get("name"), mass, centre))
+                inertials.append((link_name, mass, centre))
             for col in link.findall("collision"):
                 box = col.find("geometry/box")
                 if box is not None:
-                    size = np.array(
-                        [float(v) for v in box.get("size").split()]  # type: ignore[union-attr]
+                    size = _attr(box, "size", f"the collision box of {link_name!r}")
+                    boxes[link_name] = (
+                        _pose(col.find("origin")),
+                        np.array([float(v) for v in size.split()]),
                     )
-                    boxes[link.get("name")] = (_pose(col.find("origin")), size)
         children = {j[2] for j in joints}
-        names_of_links = [link.get("name") for link in tree.findall("link")]
+        names_of_links = [_attr(link, "name", "a <link>") for link in tree.findall("link")]
         root = next(n for n in names_of_links if n not in children)
         return cls(
             tuple(names), np.array(lower), np.array(upper), tuple(joints), tuple(inertials),
@@ -170,7 +206,9 @@ class Humanoid:
     def com(self, poses: dict[str, NDArray[np.float64]]) -> NDArray[np.float64]:
         """Whole-body centre of mass (3,) from the URDF inertials."""
         total = sum(m for _, m, _ in self._inertials)
-        return sum(m * (poses[n] @ np.append(c, 1.0))[:3] for n, m, c in self._inertials) / total
+        moments = [m * (poses[n] @ np.append(c, 1.0))[:3] for n, m, c in self._inertials]
+        centre: NDArray[np.float64] = np.sum(moments, axis=0) / total
+        return centre
 
     def balance(
         self, posture: NDArray[np.float64], soles: tuple[str, str] = ("l_foot", "r_foot")

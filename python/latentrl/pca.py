@@ -2,12 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Self
 
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import Estimator, SavedSpec
+from latentrl._base import Estimator, SavedSpec, column_names
 from latentrl._validation import as_matrix
 
 
@@ -49,6 +49,20 @@ class PCA(Estimator):
         Share of the total variance along each axis.
     n_features_in_ : int
         Number of joints D seen in `fit`.
+    feature_names_in_ : ndarray (D,) of str objects
+        The joint names: the column names of a pandas DataFrame passed to `fit`, if they
+        are all strings (not set otherwise).
+
+    Notes
+    -----
+    A scikit-learn transformer, without depending on scikit-learn: it works in
+    `Pipeline`, `clone` and `GridSearchCV`, and passes every check of scikit-learn's
+    `parametrize_with_checks` (tests/test_sklearn.py). `X` may be a pandas DataFrame:
+    `transform` then wants the columns of `fit` in the same order, and raises a ValueError
+    naming the unseen, missing or misplaced ones (it warns if only one of the two had
+    column names). `transform` and `inverse_transform` return ndarrays, the latter's
+    columns in the order of `feature_names_in_`; `get_feature_names_out` names the latent
+    axes ``pca0``, ``pca1``, …
     """
 
     _saved: ClassVar[SavedSpec] = {
@@ -62,8 +76,10 @@ class PCA(Estimator):
     def __init__(self, n_components: int = 2) -> None:
         self.n_components = n_components
 
-    def fit(self, X: Any, y: Any = None) -> PCA:
-        """Fits the principal axes of `X` (N, D); returns self."""
+    def fit(self, X: Any, y: Any = None) -> Self:
+        """Fits the principal axes of `X` (N, D), an array or DataFrame; `y` is ignored.
+        Returns self."""
+        names = column_names(X)
         X = as_matrix("X", X)
         d = check_n_components(self.n_components, X)
         with np.errstate(over="ignore", invalid="ignore"):
@@ -73,6 +89,7 @@ class PCA(Estimator):
         if not (np.all(np.isfinite(mean)) and np.all(np.isfinite(variances))):
             raise ValueError("X: values too large, their variance overflows float64 (rescale X)")
         self.n_features_in_ = X.shape[1]
+        self._set_feature_names(names)
         self.mean_ = mean
         _, s, vt = np.linalg.svd(centred, full_matrices=False)
         axes = vt[:d]
@@ -87,18 +104,24 @@ class PCA(Estimator):
         )
         return self
 
+    @property
+    def _n_features_out(self) -> int:
+        return int(self.components_.shape[0])
+
     def transform(self, X: Any) -> NDArray[np.float64]:
-        """Latent points (N, d) of postures `X` (N, D)."""
-        self._check_fitted()
-        X = as_matrix("X", X, n_cols=self.n_features_in_)
-        return (X - self.mean_) @ self.components_.T
+        """Latent points (N, d) of postures `X` (N, D), an array or DataFrame."""
+        X = self._check_X(X)
+        latent: NDArray[np.float64] = (X - self.mean_) @ self.components_.T
+        return latent
 
     def fit_transform(self, X: Any, y: Any = None) -> NDArray[np.float64]:
         """`fit(X)`, then `transform(X)`."""
         return self.fit(X).transform(X)
 
     def inverse_transform(self, Z: Any) -> NDArray[np.float64]:
-        """Postures (M, D) reconstructed from latent points `Z` (M, d)."""
+        """Postures (M, D) reconstructed from latent points `Z` (M, d): an ndarray, its
+        columns in the order of `feature_names_in_`."""
         self._check_fitted()
-        Z = as_matrix("Z", Z, n_cols=self.components_.shape[0])
-        return Z @ self.components_ + self.mean_
+        Z = as_matrix("Z", Z, n_cols=self._n_features_out)
+        postures: NDArray[np.float64] = Z @ self.components_ + self.mean_
+        return postures

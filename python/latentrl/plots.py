@@ -13,6 +13,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.axes import Axes  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.patches import Circle  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
 from latentrl._base import atomic_write  # noqa: E402
@@ -51,7 +52,7 @@ def hand_paths(
 ) -> None:
     """Paths of both hands, `paths` (K, steps, 4) as (x_L, y_L, x_R, y_R), NaN-padded; discs (x, y, r)."""
     for x, y, r in discs:
-        ax.add_patch(plt.Circle((x, y), r, color="0.6", alpha=0.6))
+        ax.add_patch(Circle((x, y), r, color="0.6", alpha=0.6))
     for k, path in enumerate(paths):
         path = path[np.isfinite(path).all(axis=1)]
         if path.size == 0:

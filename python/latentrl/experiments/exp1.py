@@ -19,7 +19,7 @@ import numpy as np
 from latentrl import _native
 from latentrl.datasets import bimanual_pairs
 from latentrl.experiments.presets import check_floats, check_ints, latent_box
-from latentrl.experiments.runner import Setup, run_rl
+from latentrl.experiments.runner import RunTrials, Setup, run_rl
 from latentrl.gplvm import GPLVM
 from latentrl.plots import hand_paths, learning_curves, save_figure
 
@@ -137,7 +137,7 @@ def setup(preset: Exp1Preset) -> Setup:
         config=native_config(preset),
         record_episodes=recorded_episodes(preset.episodes),
     )
-    learners = {
+    learners: dict[str, RunTrials] = {
         "latent": partial(
             run, "latent", decoder=model.decoder_, encoder=model.encoder_, latent_low=low, latent_high=high
         ),

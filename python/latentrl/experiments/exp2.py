@@ -268,7 +268,8 @@ def value_function(
     sigma = (high - low) / (n - 1)
     d2 = (((points[:, None, :] - centres[None, :, :]) / sigma) ** 2).sum(axis=-1)
     phi = np.exp(-0.5 * (d2 - d2.min(axis=1, keepdims=True)))
-    return (phi @ weights) / phi.sum(axis=1)
+    values: NDArray[np.float64] = (phi @ weights) / phi.sum(axis=1)
+    return values
 
 
 def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:

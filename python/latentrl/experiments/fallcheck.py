@@ -78,7 +78,8 @@ def run_fallcheck(preset: FallCheckPreset | None = None) -> list[dict[str, Any]]
     }
 
     def decode(method: str, z: NDArray[np.float64]) -> NDArray[np.float64]:
-        return np.clip(coders[method][1](np.atleast_2d(z)), h.lower, h.upper)
+        decoded: NDArray[np.float64] = np.clip(coders[method][1](np.atleast_2d(z)), h.lower, h.upper)
+        return decoded
 
     rows: list[dict[str, Any]] = []
     for method in METHODS:

@@ -36,7 +36,8 @@ def write_json(path: Path, payload: Mapping[str, Any]) -> None:
 
 def write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
     """Atomic compressed NPZ."""
-    atomic_write(path, lambda f: np.savez_compressed(f, **arrays))
+    # numpy's stub types **kwds as if a key could be `allow_pickle`; ours are array names.
+    atomic_write(path, lambda f: np.savez_compressed(f, **arrays))  # type: ignore[arg-type]
 
 
 def read_json(path: Path) -> dict[str, Any]:
@@ -64,7 +65,7 @@ def _to_plain(value: Any) -> Any:
 
 def environment() -> dict[str, Any]:
     """Package and dependency versions, git revision if known, Python, platform, threads."""
-    versions = {}
+    versions: dict[str, str | None] = {}
     for name in ("latentrl", "numpy", "scipy", "matplotlib"):
         try:
             versions[name] = metadata.version(name)

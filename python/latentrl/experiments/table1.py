@@ -26,7 +26,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -37,7 +37,7 @@ from latentrl.experiments.results import environment, worker_threads, write_json
 
 SPACES = ("end_effector", "joint")
 METHODS = ("PCA", "GPLVM")
-TESTS = ("distance", "vector")
+CONSTRAINT_TESTS: tuple[Literal["distance"], Literal["vector"]] = ("distance", "vector")
 
 PAPER: dict[str, dict[str, dict[str, tuple[float, float]]]] = {
     "end_effector": {
@@ -120,9 +120,9 @@ class Table1Preset:
         for i, margin in enumerate(self.variant_margins):
             if not (np.isfinite(margin) and margin >= 0):
                 raise ValueError(f"variant_margins[{i}] must be a finite number >= 0, got {margin!r}")
-        if self.constraint_test not in TESTS:
+        if self.constraint_test not in CONSTRAINT_TESTS:
             raise ValueError(
-                f"constraint_test must be one of {TESTS}, got {self.constraint_test!r}"
+                f"constraint_test must be one of {CONSTRAINT_TESTS}, got {self.constraint_test!r}"
             )
         if self.encode_method not in ("gp", "projection"):
             raise ValueError(
@@ -187,7 +187,7 @@ def _evaluate(
         hands = arms_forward(decoded) if joint else decoded
         out["constraint"][_margin_key(margin)] = {
             test_name: 100.0 * float(np.mean(grip_error(hands, test=test_name) <= preset.tolerance))
-            for test_name in TESTS
+            for test_name in CONSTRAINT_TESTS
         }
     return out
 
@@ -269,7 +269,7 @@ def summarise(preset: Table1Preset, trials: list[dict[str, Any]]) -> dict[str, A
                 if space == "joint":
                     entry["recon_joint"] = _mean_sd([r["recon_joint"] for r in rows])
                 entry["constraint"] = {
-                    m: {k: _mean_sd([r["constraint"][m][k] for r in rows]) for k in TESTS}
+                    m: {k: _mean_sd([r["constraint"][m][k] for r in rows]) for k in CONSTRAINT_TESTS}
                     for m in rows[0]["constraint"]
                 }
                 if method == "GPLVM":
@@ -296,7 +296,7 @@ def format_table(result: dict[str, Any]) -> str:
     preset = result["preset"]
     main = result["summary"]["main"]
     margin, test = _margin_key(preset["latent_margin"]), preset["constraint_test"]
-    lines = [
+    lines: list[str] = [
         f"## Table I — ours (mean ± s.d. over {preset['trials']} trials) beside the paper's (20 trials)",
         "",
         "| space | method | recon. RMSE ×10² | paper | joint RMSE ×10² (rad) | constraint % | paper |",
@@ -348,8 +348,8 @@ def format_table(result: dict[str, Any]) -> str:
             "|---|---|---|---|---|---|---|",
         ]
         for row in result["variants"]["constraint"]:
-            cells = " | ".join(_pm(row[f"{s}/{m}"], 1) for s in SPACES for m in METHODS)
-            lines.append(f"| {row['fit']} | {row['margin']} | {row['test']} | {cells} |")
+            row_cells = " | ".join(_pm(row[f"{s}/{m}"], 1) for s in SPACES for m in METHODS)
+            lines.append(f"| {row['fit']} | {row['margin']} | {row['test']} | {row_cells} |")
         lines += [
             "",
             "### Reconstruction RMSE ×10² by demos / fit (joint space: hands, metres)",
@@ -360,8 +360,8 @@ def format_table(result: dict[str, Any]) -> str:
             "|---|---|---|---|---|---|",
         ]
         for row in result["variants"]["recon"]:
-            cells = " | ".join(_pm(row[f"{s}/{m}"]) for s in SPACES for m in METHODS)
-            lines.append(f"| {row['fit']} | {cells} | {_pm(row['joint/GPLVM/rad'])} |")
+            row_cells = " | ".join(_pm(row[f"{s}/{m}"]) for s in SPACES for m in METHODS)
+            lines.append(f"| {row['fit']} | {row_cells} | {_pm(row['joint/GPLVM/rad'])} |")
     lines += [
         "",
         f"Wall time {result['wall_time_s']:.1f} s with {result['workers']} worker process(es).",
@@ -383,7 +383,7 @@ def _variants(preset: Table1Preset, summary: dict[str, Any]) -> dict[str, list[d
     for label in preset.fit_configs():
         name = FIT_NAMES[label].format(floor=preset.variant_noise_floor)
         for margin in preset.margins():
-            for test in TESTS:
+            for test in CONSTRAINT_TESTS:
                 if label != "main" and test != preset.constraint_test:
                     continue
                 row: dict[str, Any] = {"fit": name, "margin": f"{100 * margin:g} %", "test": test}
