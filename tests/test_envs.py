@@ -9,13 +9,14 @@ from gymnasium.utils.env_checker import check_env
 from latentrl import GPLVM, PCA
 from latentrl._native import arms_ik
 from latentrl.datasets import arm_postures, bimanual_pairs
-from latentrl.envs import BimanualReachEnv, LatentSpaceWrapper, TwoArmsEnv
+from latentrl import humanoid, load_demos
+from latentrl.envs import BimanualReachEnv, HumanoidLiftEnv, LatentSpaceWrapper, TwoArmsEnv
 
 IDS = sorted(env_id for env_id in gym.registry if env_id.startswith("latentrl/"))
 
 
-def test_both_tasks_are_registered():
-    assert IDS == ["latentrl/BimanualReach-v0", "latentrl/TwoArms-v0"]
+def test_every_task_is_registered():
+    assert IDS == ["latentrl/BimanualReach-v0", "latentrl/HumanoidLift-v0", "latentrl/TwoArms-v0"]
 
 
 @pytest.mark.parametrize("env_id", IDS)
@@ -87,6 +88,61 @@ def test_two_arms_observation_is_posture_then_hands():
     np.testing.assert_allclose(obs[4:6] + [0.1, 0.0], obs[6:], atol=1e-4)
 
 
+def test_humanoid_holds_still_then_drops_or_falls():
+    env = HumanoidLiftEnv()
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == (25,) and np.array_equal(obs[:19], env.posture)
+    start_base = env.sim.base_position()
+    for _ in range(20):  # 1 s of zero actions: the targets hold, the robot stands
+        obs, reward, terminated, truncated, info = env.step(np.zeros(19))
+        assert not terminated and not truncated and 0 < reward < 1
+    assert np.linalg.norm(env.sim.base_position() - start_base) < 0.02
+    grip = np.linalg.norm(obs[22:25] - obs[19:22])
+    assert abs(grip - humanoid.GRIP_WIDTH) < 0.005
+    # Opening both shoulders spreads the hands: the object drops.
+    j = env.joint_names
+    spread = np.zeros(19)
+    spread[j.index("l_shoulder_roll")], spread[j.index("r_shoulder_roll")] = 0.1, -0.1
+    env.reset(seed=0)
+    _, reward, terminated, _, info = env.step(spread)
+    assert terminated and info["end_reason"] == "drop" and reward < 0
+    # Tipping both ankles forward, step after step, topples the robot; the grip holds.
+    tip = np.zeros(19)
+    tip[j.index("l_ankle_pitch")] = tip[j.index("r_ankle_pitch")] = 0.1
+    env.reset(seed=0)
+    for _ in range(40):
+        _, reward, terminated, _, info = env.step(tip)
+        if terminated:
+            break
+    assert terminated and info["end_reason"] == "fall" and reward < 0
+
+
+def test_humanoid_reward_peaks_at_the_highest_demonstrated_hands():
+    env = HumanoidLiftEnv()
+    demos = load_demos(humanoid.demos_path(), expected_joints=env.joint_names).postures
+    rewards = []
+    for pose in demos:
+        env.reset(options={"posture": pose})
+        _, reward, *_ = env.step(np.zeros(19))
+        rewards.append(reward)
+    assert max(rewards) > 0.8 and min(rewards) < 0.2, rewards
+
+
+@pytest.mark.filterwarnings("ignore:.*different from the unwrapped")
+def test_latent_wrapper_on_the_humanoid_passes_check_env():
+    demos = load_demos(humanoid.demos_path(), expected_joints=HumanoidLiftEnv().joint_names).postures
+    model = GPLVM(max_iter=100, random_state=0).fit(demos)
+    wrapped = LatentSpaceWrapper(gym.make("latentrl/HumanoidLift-v0"), model)
+    check_env(wrapped)
+    z, _ = wrapped.reset(seed=0)
+    u = 0.5 * wrapped.action_space.high
+    wrapped.step(u)
+    # The servo targets are the decoded latent target (clipped to the joint limits).
+    target = model.inverse_transform((z + u)[None])[0]
+    lower, upper = humanoid.model().lower, humanoid.model().upper
+    np.testing.assert_allclose(wrapped.unwrapped.sim.targets(), np.clip(target, lower, upper), atol=1e-9)
+
+
 @pytest.fixture(scope="module")
 def arms_gplvm():
     return GPLVM(max_iter=50, random_state=0).fit(arm_postures(40, np.random.default_rng(0)))
@@ -135,6 +191,10 @@ def test_bad_arguments():
         TwoArmsEnv(render_mode="human")
     with pytest.raises(ValueError, match="options\\['posture'\\]"):
         BimanualReachEnv().reset(options={"posture": [0.0, 1.0]})
+    with pytest.raises(ValueError, match="expected 19 finite values"):
+        HumanoidLiftEnv().reset(options={"posture": np.zeros(4)})
+    with pytest.raises(ValueError, match="start_noise"):
+        HumanoidLiftEnv(start_noise=-0.1)
     pca3 = PCA().fit(np.random.default_rng(0).normal(size=(10, 3)))
     with pytest.raises(ValueError, match="postures of 4 values"):
         LatentSpaceWrapper(BimanualReachEnv(), pca3)

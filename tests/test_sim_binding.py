@@ -126,3 +126,24 @@ def test_floating_humanoid_stands_on_the_ground_and_falls_without_it():
 def test_ground_must_be_finite():
     with pytest.raises(InvalidInputError, match="ground"):
         Sim(arms_urdf(), ground=float("nan"))
+
+
+def test_reset_on_ground_and_fall_status_check_their_inputs():
+    from latentrl import humanoid
+
+    floating = Sim(str(humanoid.urdf_path()), root="floating", ground=0.0)
+    home = np.zeros(len(floating.joint_names))
+    floating.reset_on_ground(home, "l_foot")
+    fell, height, tilt, contact = floating.fall_status(["l_foot", "r_foot"], min_base_height=0.05)
+    assert not fell and height == pytest.approx(floating.base_position()[2]) and tilt < 1e-6 and contact is None
+    assert floating.fall_status(["l_foot", "r_foot"], min_base_height=1.0)[0]  # base below 1 m: fallen
+    with pytest.raises(InvalidInputError, match="no floor"):
+        Sim(str(humanoid.urdf_path()), root="floating").reset_on_ground(home, "l_foot")
+    with pytest.raises(ValueError, match="l_paw"):
+        floating.reset_on_ground(home, "l_paw")
+    with pytest.raises(ValueError, match="clearance"):
+        floating.reset_on_ground(home, "l_foot", clearance=float("nan"))
+    with pytest.raises(ValueError, match="fall criteria"):
+        floating.fall_status(["l_foot"], min_base_height=float("inf"))
+    with pytest.raises(ValueError, match="r_paw"):
+        floating.fall_status(["r_paw"], min_base_height=0.05)

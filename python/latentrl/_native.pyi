@@ -100,6 +100,18 @@ class Sim:
         """Simulated time since the last reset (s)."""
     def reset(self, posture: NDArray[np.float64]) -> None:
         """Teleports the robot to `posture` (num_joints,) at rest and aims the servos at it."""
+    def reset_on_ground(self, posture: NDArray[np.float64], sole: str, clearance: float = 5e-4) -> None:
+        """Teleports a floating robot to `posture` at rest standing on the floor: the base is
+        placed so that link `sole` lies flat, its lowest corner `clearance` m above the ground
+        (needs `ground`)."""
+    def base_position(self) -> NDArray[np.float64]:
+        """World position (3,) of the root link's origin (the floating base)."""
+    def fall_status(
+        self, soles: list[str], *, min_base_height: float, max_sole_tilt: float = ...
+    ) -> tuple[bool, float, float, str | None]:
+        """The fall test now: `(fell, base_height, sole_tilt, ground_contact)`, fallen when the
+        base origin is below `min_base_height` (m), a link of `soles` tilts more than
+        `max_sole_tilt` (rad) or another link touches the floor (the first such link, else None)."""
     def set_targets(self, targets: NDArray[np.float64]) -> None:
         """Sets every servo target (num_joints,), clamped to the joint limits."""
     def targets(self) -> NDArray[np.float64]:

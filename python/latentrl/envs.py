@@ -3,12 +3,14 @@
 - `latentrl/BimanualReach-v0`: Experiment 1's kinematic toy (SPEC §4.1), in NumPy.
 - `latentrl/TwoArms-v0`: Experiment 2's two planar arms (SPEC §4.2), simulated by the Rust
   `Sim` (rapier3d, PD servos).
+- `latentrl/HumanoidLift-v0`: the 19-DoF KHR-1HV-like humanoid of Experiment 3 (SPEC §4.3)
+  standing on a floor, lifting an object with both hands, simulated by the same `Sim`.
 - `LatentSpaceWrapper`: observations and actions in the latent space of a fitted `PCA` or
   `GPLVM` (SPEC §3.1): an action is a latent delta, the target latent point is decoded to a
   posture target, and the reached posture is encoded back.
 
-Both environments expose `posture` (the current posture, (4,)) so the wrapper can encode it;
-an action is a posture delta, clipped to the action space, added to the current posture.
+Every environment exposes `posture` (the current posture, (D,)) so the wrapper can encode
+it, and `action_origin`, what an action (a delta, clipped to the action space) is added to.
 """
 
 from __future__ import annotations
@@ -21,11 +23,12 @@ import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
-from latentrl import _native
+from latentrl import _native, humanoid
 from latentrl._validation import positive
 from latentrl.datasets import OFFSET, arms_forward
+from latentrl.demos import load_demos
 
-__all__ = ["BimanualReachEnv", "LatentSpaceWrapper", "TwoArmsEnv"]
+__all__ = ["BimanualReachEnv", "HumanoidLiftEnv", "LatentSpaceWrapper", "TwoArmsEnv"]
 
 Obs = NDArray[np.float64]
 
@@ -45,12 +48,12 @@ def _pixels(fig: Any) -> NDArray[np.uint8]:
     return np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
 
 
-def _posture_option(options: dict[str, Any] | None) -> Obs | None:
+def _posture_option(options: dict[str, Any] | None, n: int = 4) -> Obs | None:
     if not options or options.get("posture") is None:
         return None
     posture = np.asarray(options["posture"], dtype=np.float64)
-    if posture.shape != (4,) or not np.all(np.isfinite(posture)):
-        raise ValueError(f"options['posture']: expected 4 finite values, got {posture!r}")
+    if posture.shape != (n,) or not np.all(np.isfinite(posture)):
+        raise ValueError(f"options['posture']: expected {n} finite values, got {posture!r}")
     return posture
 
 
@@ -120,6 +123,11 @@ class BimanualReachEnv(gym.Env[Obs, Obs]):
         low, high = self.box[0] - max_step, self.box[1] + max_step
         self.observation_space = spaces.Box(low, high, (4,), np.float64)
         self.posture = np.zeros(4)
+
+    @property
+    def action_origin(self) -> Obs:
+        """What an action's delta is added to: the current state (4,)."""
+        return self.posture
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -252,6 +260,11 @@ class TwoArmsEnv(gym.Env[Obs, Obs]):
         """The reached joint angles (4,)."""
         return self.sim.joint_positions()
 
+    @property
+    def action_origin(self) -> Obs:
+        """What an action's delta is added to: the reached posture (4,)."""
+        return self.posture
+
     def hands(self) -> Obs:
         """The simulated hand positions `(x_L, y_L, x_R, y_R)`."""
         left = self.sim.frame_position("left_hand")[:2]
@@ -319,6 +332,164 @@ class TwoArmsEnv(gym.Env[Obs, Obs]):
         return _pixels(fig)
 
 
+class HumanoidLiftEnv(gym.Env[Obs, Obs]):
+    """The 19-DoF KHR-1HV-like humanoid lifting an object with both hands (SPEC §4.3).
+
+    ## Description
+    The shipped robot (`humanoid.urdf_path()`, 0.34 m, 1.29 kg) stands on a floor under
+    gravity in a rapier3d world, every joint servo-PD'd to its target with the gains of the
+    fall check (`humanoid.SERVO`: kp 8 N·m/rad, kd 0.1, torque cap 1.2 N·m; physics step
+    1/240 s, 4 solver iterations, 12 steps = 0.05 s per env step). It holds an object of
+    `humanoid.GRIP_WIDTH` (0.10 m) between its hands and should raise it to the top of the
+    demonstrated lift without dropping it or falling.
+
+    ## Action Space
+    `Box(-max_step, max_step, (19,), float64)`: deltas of the joint targets (rad, in the order
+    of `joint_names`), added to the current targets (`action_origin`; the sim clamps targets
+    to the limits). Zero holds the robot where it was sent.
+
+    ## Observation Space
+    `Box(low, high, (25,), float64)`: the 19 joint angles (rad, within the URDF limits
+    widened by 0.1), then the hands `(x, y, z)` left and right (m, world frame: x forward,
+    y left, z up; within ±1 m).
+
+    ## Rewards
+    `exp(−0.35 ‖(h − h*)/0.1 m‖²)` over both hands (Eq. 12 with a length unit at the robot's
+    scale; ours), `h*` = the hands of the demonstrated pose that holds them highest, that
+    pose standing on the floor. A step that ends the episode earns that reward plus −1.
+
+    ## Starting State
+    The first pose of the lift demonstrations (`humanoid.demos_path()`: object low, straight
+    arms) plus uniform noise of ±`start_noise` rad per joint, standing flat on the left sole.
+    `reset(options={"posture": q})` starts at the joint angles `q` instead.
+
+    ## Episode End
+    Terminated (with the penalty) on a fall (`"fall"`: a sole tilting more than 20°, another
+    link touching the floor, or the base height halving from the start) or a drop
+    (`"drop"`: | ‖h_R − h_L‖ − 0.10 | > `drop_tolerance`); `info["end_reason"]` says which,
+    `info["reached"]` whether the RMS per-hand distance to `h*` is ≤ 0.02 m. Truncated after
+    200 steps (SPEC §4.3).
+
+    ## Arguments
+    `drop_tolerance` (0.02 m, ours), `max_step` (0.1 rad), `start_noise` (0.01 rad),
+    `render_mode` (`None` or `"rgb_array"`: a side view of the links).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
+    theta = 0.35
+    length_scale = 0.1
+    reach_radius = 0.02
+    penalty = -1.0
+    soles = ["l_foot", "r_foot"]
+    hand_links = ("l_hand", "r_hand")
+
+    def __init__(
+        self,
+        drop_tolerance: float = 0.02,
+        max_step: float = 0.1,
+        start_noise: float = 0.01,
+        render_mode: str | None = None,
+    ) -> None:
+        self.drop_tolerance = positive("drop_tolerance", drop_tolerance)
+        self.max_step = positive("max_step", max_step)
+        if not (np.isfinite(start_noise) and start_noise >= 0):
+            raise ValueError(f"start_noise must be finite and >= 0, got {start_noise!r}")
+        self.start_noise = float(start_noise)
+        self.render_mode = _check_render_mode(render_mode, self.metadata["render_modes"])
+        self.sim = self._new_sim()
+        self.dt = self.sim.dt
+        """One env step (s): physics step × sub-steps."""
+        self.joint_names = self.sim.joint_names
+        demos = load_demos(humanoid.demos_path(), expected_joints=self.joint_names).postures
+        self.start_posture = demos[0]
+        heights = []
+        for pose in demos:
+            self.sim.reset_on_ground(pose, self.soles[0])
+            heights.append((self.hands()[[2, 5]].mean(), self.hands()))
+        self.target = max(heights, key=lambda item: float(item[0]))[1]
+        n = len(self.joint_names)
+        self.action_space = spaces.Box(-max_step, max_step, (n,), np.float64)
+        limits = humanoid.model()
+        reach = np.tile([1.0, 1.0, 1.0], 2)
+        self.observation_space = spaces.Box(
+            np.concatenate([limits.lower - 0.1, -reach]), np.concatenate([limits.upper + 0.1, reach]), (n + 6,), np.float64
+        )
+        self.min_base_height = 0.0
+
+    @staticmethod
+    def _new_sim() -> _native.Sim:
+        # A fresh world per episode: rapier keeps contact impulses (warm start) and rounds
+        # joint coordinates relative to the previous state across a teleport, so a reset
+        # in place would make an episode depend on the one before it.
+        return _native.Sim(
+            str(humanoid.urdf_path()), root="floating", ground=0.0, substeps=12, **humanoid.SERVO, **humanoid.PHYSICS
+        )
+
+    @property
+    def posture(self) -> Obs:
+        """The reached joint angles (19,)."""
+        return self.sim.joint_positions()
+
+    @property
+    def action_origin(self) -> Obs:
+        """What an action's delta is added to: the servo targets (19,), so that a zero
+        action holds the robot where it was sent (the reached posture sags under gravity)."""
+        return self.sim.targets()
+
+    def hands(self) -> Obs:
+        """The simulated hand positions `(x_L, y_L, z_L, x_R, y_R, z_R)` (m)."""
+        return np.concatenate([self.sim.frame_position(link) for link in self.hand_links])
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Obs, dict[str, Any]]:
+        """Stands the robot at the first demonstrated pose plus noise (seeded by `seed`), or at
+        ``options["posture"]``; returns the observation and an empty info dict."""
+        super().reset(seed=seed)
+        posture = _posture_option(options, len(self.joint_names))
+        if posture is None:
+            noise = self.np_random.uniform(-self.start_noise, self.start_noise, len(self.joint_names))
+            limits = humanoid.model()
+            posture = np.clip(self.start_posture + noise, limits.lower, limits.upper)
+        self.sim = self._new_sim()
+        self.sim.reset_on_ground(posture, self.soles[0])
+        self.min_base_height = 0.5 * float(self.sim.base_position()[2])
+        return np.concatenate([self.posture, self.hands()]), {}
+
+    def step(self, action: Obs) -> tuple[Obs, SupportsFloat, bool, bool, dict[str, Any]]:
+        """Moves the servo targets by `action` (clipped to ±`max_step`) and runs the physics
+        sub-steps; returns observation, reward, terminated (fall or drop), truncated (never)
+        and info (``end_reason``, ``reached``)."""
+        delta = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
+        self.sim.set_targets(self.action_origin + delta)
+        self.sim.step()
+        hands = self.hands()
+        d2 = float(np.sum((hands - self.target) ** 2))
+        reward = float(np.exp(-self.theta * d2 / self.length_scale**2))
+        fell = self.sim.fall_status(self.soles, min_base_height=self.min_base_height)[0]
+        grip = abs(float(np.linalg.norm(hands[3:] - hands[:3])) - humanoid.GRIP_WIDTH)
+        reason = "fall" if fell else "drop" if grip > self.drop_tolerance else None
+        if reason is not None:
+            reward += self.penalty
+        info = {"end_reason": reason, "reached": bool(np.sqrt(d2 / 2) <= self.reach_radius)}
+        return np.concatenate([self.posture, hands]), reward, reason is not None, False, info
+
+    def render(self) -> NDArray[np.uint8] | None:
+        """An RGB side view (H, W, 3) of the robot's links (x–z plane), the hands' target and
+        the floor if `render_mode` is ``"rgb_array"``, else None."""
+        if self.render_mode != "rgb_array":
+            return None
+        fig, ax = _canvas()
+        base = self.sim.base_position()
+        ax.set(xlim=(base[0] - 0.25, base[0] + 0.25), ylim=(-0.05, 0.45))
+        ax.axhline(0.0, color="0.4", lw=2)
+        for parent, child in humanoid.model().edges:
+            a, b = self.sim.frame_position(parent), self.sim.frame_position(child)
+            ax.plot([a[0], b[0]], [a[2], b[2]], "o-", color="C0", lw=2, ms=3)
+        ax.plot(self.target[[0, 3]], self.target[[2, 5]], "g*", ms=10)
+        return _pixels(fig)
+
+
 class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstructorArgs):
     """RL in the latent space of a fitted `PCA` or `GPLVM` (SPEC §3.1, Fig. 3).
 
@@ -327,7 +498,8 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
     target `z + u` outside the latent box is refused (no plant step, reward −1, terminated,
     `info["end_reason"] = "box_exit"`, SPEC §3.1 step 2); otherwise it is decoded
     (`model.inverse_transform`) to a posture target and handed to the wrapped environment as
-    the posture delta `x̂ − x` (which it clips to its own action space). With
+    the delta `x̂ − o` from its `action_origin` `o` (the reached posture of the toy and the
+    arms, the servo targets of the humanoid), which it clips to its own action space. With
     `variance_threshold`, a target whose predictive variance (`model.predict_variance`,
     GPLVM only) exceeds it is refused the same way (`"gated"`, SPEC §3.2).
 
@@ -419,8 +591,8 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
         if refused is not None:
             return self.z.copy(), self.penalty, True, False, {"end_reason": refused}
         target = self.model.inverse_transform(target_z[None])[0]
-        posture = np.asarray(self.env.unwrapped.posture)  # type: ignore[attr-defined]
-        _, reward, terminated, truncated, info = self.env.step(target - posture)
+        origin = np.asarray(self.env.unwrapped.action_origin)  # type: ignore[attr-defined]
+        _, reward, terminated, truncated, info = self.env.step(target - origin)
         self.z = self._encode()
         return self.z.copy(), reward, terminated, truncated, info
 
@@ -429,6 +601,7 @@ def _register() -> None:
     for env_id, entry, steps in (
         ("latentrl/BimanualReach-v0", "latentrl.envs:BimanualReachEnv", 500),
         ("latentrl/TwoArms-v0", "latentrl.envs:TwoArmsEnv", 1000),
+        ("latentrl/HumanoidLift-v0", "latentrl.envs:HumanoidLiftEnv", 200),
     ):
         if env_id not in gym.registry:
             gym.register(id=env_id, entry_point=entry, max_episode_steps=steps)

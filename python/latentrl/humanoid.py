@@ -152,6 +152,11 @@ class Humanoid:
             boxes, root,
         )
 
+    @property
+    def edges(self) -> list[tuple[str, str]]:
+        """(parent link, child link) of every joint: the kinematic tree, e.g. to draw it."""
+        return [(parent, child) for _, parent, child, _, _ in self._joints]
+
     def index(self, name: str) -> int:
         """Column of joint `name` in a posture."""
         return self.joint_names.index(name)

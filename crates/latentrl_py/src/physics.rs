@@ -3,7 +3,8 @@
 
 use std::path::PathBuf;
 
-use ::sim::{Obstacle, ObstacleShape, PdGains, PhysicsSim, RootMode, SimOptions, UrdfModel};
+use ::sim::humanoid::reset_on_ground;
+use ::sim::{FallCriteria, Obstacle, ObstacleShape, PdGains, PhysicsSim, RootMode, SimOptions, UrdfModel};
 use nalgebra::Isometry3;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
@@ -114,6 +115,46 @@ impl PySim {
     /// Teleports the robot to `posture` (num_joints,) at rest and aims the servos at it.
     fn reset(&mut self, posture: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
         guard(|| self.inner.reset(&vector(&posture)).map_err(sim_to_py))
+    }
+
+    /// Teleports a floating robot to `posture` at rest standing on the floor: the base is
+    /// placed so that link `sole` lies flat, its lowest corner `clearance` m above the ground
+    /// (needs `ground`).
+    #[pyo3(signature = (posture, sole, clearance = 5e-4))]
+    fn reset_on_ground(&mut self, posture: PyReadonlyArray1<'_, f64>, sole: &str, clearance: f64) -> PyResult<()> {
+        guard(|| {
+            let ground = self.inner.options().ground.ok_or_else(|| {
+                InvalidInputError::new_err("reset_on_ground: this Sim has no floor (pass ground=...)")
+            })?;
+            reset_on_ground(&mut self.inner, &vector(&posture), sole, ground, clearance).map_err(sim_to_py)
+        })
+    }
+
+    /// World position (3,) of the root link's origin (the floating base).
+    fn base_position<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let t = self.inner.base_pose().translation;
+        PyArray1::from_vec(py, vec![t.x, t.y, t.z])
+    }
+
+    /// The fall test now: `(fell, base_height, sole_tilt, ground_contact)`, fallen when the
+    /// base origin is below `min_base_height` (m), a link of `soles` tilts more than
+    /// `max_sole_tilt` (rad) or another link touches the floor (the first such link, else None).
+    #[pyo3(signature = (soles, *, min_base_height, max_sole_tilt = 20f64.to_radians()))]
+    fn fall_status(
+        &self,
+        soles: Vec<String>,
+        min_base_height: f64,
+        max_sole_tilt: f64,
+    ) -> PyResult<(bool, f64, f64, Option<String>)> {
+        guard(|| {
+            let criteria = FallCriteria {
+                min_base_height,
+                max_sole_tilt,
+                soles,
+            };
+            let s = self.inner.fall_status(&criteria).map_err(sim_to_py)?;
+            Ok((s.fell, s.base_height, s.sole_tilt, s.ground_contact))
+        })
     }
 
     /// Sets every servo target (num_joints,), clamped to the joint limits.

@@ -216,6 +216,7 @@ pub fn support_margin(sim: &PhysicsSim, soles: &[String]) -> Result<f64> {
 /// placed so that this sole's frame keeps its x–y position and heading at the identity
 /// base, with no roll or pitch, and its lowest box corner `clearance` (m) above `ground`.
 pub fn reset_on_ground(sim: &mut PhysicsSim, posture: &[f64], sole: &str, ground: f64, clearance: f64) -> Result<()> {
+    check_finite("ground height and clearance", &[ground, clearance])?;
     sim.reset_with_base(posture, &Isometry3::identity())?;
     let sole_pose = sim.link_pose(sole)?;
     let (_, _, yaw) = sole_pose.rotation.euler_angles();

@@ -265,6 +265,7 @@ pub struct FallStatus {
 impl PhysicsSim {
     /// Evaluates `criteria` at the current state; fails on an unknown sole link.
     pub fn fall_status(&self, criteria: &FallCriteria) -> Result<FallStatus> {
+        crate::error::check_finite("fall criteria", &[criteria.min_base_height, criteria.max_sole_tilt])?;
         let base_height = self.base_pose().translation.z;
         let mut sole_tilt: f64 = 0.0;
         for sole in &criteria.soles {
