@@ -37,7 +37,7 @@ def test_help_documents_every_preset_flag():
     assert "--drop-tolerance" in exp1.stdout and "Soft-max inverse temperature" in exp1.stdout
 
 
-@pytest.mark.parametrize("experiment", ["table1", "exp1", "exp2"])
+@pytest.mark.parametrize("experiment", ["table1", "exp1", "exp2", "exp3"])
 def test_help_of_every_experiment_renders(experiment):
     # A "%" in a field docstring once broke argparse's help formatting for exp2.
     result = latentrl("run", experiment, "--help")
@@ -91,6 +91,8 @@ TINY_RUNS = {
     "exp1": ["--quick", "--trials", "3", "--episodes", "40", "--steps", "300"],
     "exp2": ["--quick", "--trials", "3", "--episodes", "20", "--steps", "500", "--test-episodes", "2",
              "--fig5-samples", "200", "--gplvm-max-iter", "100"],
+    "exp3": ["--quick", "--trials", "2", "--episodes", "3", "--steps", "8", "--test-episodes", "1",
+             "--map-grid", "8"],
 }
 # Ctrl-C must reach the child even where the test runner was started with SIGINT ignored
 # (a background job of a non-interactive shell): the child restores Python's handler.

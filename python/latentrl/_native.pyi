@@ -22,6 +22,7 @@ __all__ = [
     "humanoid_fall_check",
     "run_arms_trials",
     "run_bimanual_trials",
+    "run_lift_trials",
 ]
 
 __version__: str
@@ -212,3 +213,25 @@ def run_arms_trials(
 ) -> dict[str, Any]:
     """Runs Experiment 2 (SPEC §4.2) trials in parallel in Rust on two simulated arms (rapier3d,
     PD servos) learning in a 2-D latent space; see `run_arms_trials.__doc__`."""
+
+def run_lift_trials(
+    urdf: str | PathLike[str],
+    *,
+    decoder: GpMap,
+    encoder: GpMap,
+    latent_low: ArrayLike,
+    latent_high: ArrayLike,
+    n_trials: int,
+    episodes: int,
+    base_seed: int,
+    first_trial: int | None = None,
+    config: Mapping[str, object] | None = None,
+    record_episodes: Sequence[int] | None = None,
+    test_episodes: int | None = None,
+    record_test_episodes: Sequence[int] | None = None,
+    return_weights: bool = False,
+    progress: Callable[[int, int], object] | None = None,
+) -> dict[str, Any]:
+    """Runs Experiment 3 (SPEC §4.3) trials in parallel in Rust on the simulated humanoid
+    (rapier3d, servo PD, floor) lifting an object from a 2-D latent space; see
+    `run_lift_trials.__doc__`."""

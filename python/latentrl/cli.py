@@ -34,12 +34,13 @@ class Experiment(NamedTuple):
 
 def _experiments() -> dict[str, Experiment]:
     """Experiment name → its preset, runner and figures."""
-    from latentrl.experiments import exp1, exp2, table1
+    from latentrl.experiments import exp1, exp2, exp3, table1
 
     return {
         "table1": Experiment(table1.Table1Preset, table1.run_table1, None),
         "exp1": Experiment(exp1.Exp1Preset, exp1.run_exp1, exp1.figures),
         "exp2": Experiment(exp2.Exp2Preset, exp2.run_exp2, exp2.figures),
+        "exp3": Experiment(exp3.Exp3Preset, exp3.run_exp3, exp3.figures),
     }
 
 
@@ -102,7 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--max-iter", type=int, default=1000, help="L-BFGS iteration cap of the GPLVM (default: 1000)")
     fit.add_argument("--out", type=Path, required=True, help="the model file to write (.npz; load with GPLVM.load)")
     plot = sub.add_parser("plot", help="redraw the figures of a results directory (finished trials only)")
-    plot.add_argument("results", type=Path, help="a results directory of `latentrl run exp1|exp2`")
+    plot.add_argument("results", type=Path, help="a results directory of `latentrl run exp1|exp2|exp3`")
     plot.add_argument("--out", type=Path, help="where to write the figures (default: the results directory)")
     sub.add_parser("info", help="print versions, git revision and thread count as JSON")
     return parser

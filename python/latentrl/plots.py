@@ -1,10 +1,12 @@
-"""Paper figures: learning curves (mean ± s.d. over trials) and hand trajectories, saved as PNG + PDF."""
+"""Paper figures: learning curves (mean ± s.d. over trials), hand trajectories and value functions
+over a latent space, saved as PNG + PDF."""
 
 from __future__ import annotations
 
 import io
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -65,6 +67,65 @@ def hand_paths(
     ax.set_aspect("equal")
     ax.set_xlabel("x")
     ax.set_ylabel("y")
+
+
+def value_function(
+    weights: NDArray[np.float64],
+    low: NDArray[np.float64],
+    high: NDArray[np.float64],
+    points: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """V(z) = Σ w_i b_i(z) at `points` (M, 2) with dense normalised RBFs (σ = spacing) on the
+    learner's grid, flat index with dimension 0 fastest (as the Rust grid). The learner's
+    3σ cut-off changes V by less than the Rust tests' stated tolerance."""
+    n = int(round(np.sqrt(weights.size)))
+    axes = [np.linspace(lo, hi, n) for lo, hi in zip(low, high)]
+    c0, c1 = np.meshgrid(axes[0], axes[1], indexing="xy")
+    centres = np.column_stack([c0.ravel(), c1.ravel()])
+    sigma = (high - low) / (n - 1)
+    d2 = (((points[:, None, :] - centres[None, :, :]) / sigma) ** 2).sum(axis=-1)
+    phi = np.exp(-0.5 * (d2 - d2.min(axis=1, keepdims=True)))
+    values: NDArray[np.float64] = (phi @ weights) / phi.sum(axis=1)
+    return values
+
+
+#: Draws an experiment's regions on a latent panel: `regions(ax, g0, g1, postures)` with the
+#: grid's coordinates g0, g1 (grid, grid) and the decoded postures (grid², D), row by row.
+Regions = Callable[[Axes, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]], None]
+
+
+def latent_value_panel(
+    ax: Axes,
+    weights: NDArray[np.float64],
+    low: NDArray[np.float64],
+    high: NDArray[np.float64],
+    model: Any,
+    *,
+    regions: Regions | None = None,
+    grid: int = 120,
+) -> None:
+    """V over the 2-D latent box [low, high] (`value_function` of `weights`), the GPLVM variance
+    of `model.decoder_` shaded (darker = higher, log scale), the experiment's `regions` and
+    the demonstrations' latent points `model.Z_` (white dots) (paper Fig. 6b/d, 7b/c)."""
+    g0, g1 = np.meshgrid(np.linspace(low[0], high[0], grid), np.linspace(low[1], high[1], grid))
+    points = np.column_stack([g0.ravel(), g1.ravel()])
+    postures, variance = model.decoder_.predict(points)
+    shape = g0.shape
+    value = value_function(weights, low, high, points).reshape(shape)
+    extent = (low[0], high[0], low[1], high[1])
+    image = ax.imshow(value, origin="lower", extent=extent, aspect="auto", cmap="viridis")
+    plt.colorbar(image, ax=ax, label="V")
+    # Log scale: the variance spans orders of magnitude from the demonstrations to the corners.
+    log_var = np.log(np.maximum(variance, 1e-300))
+    shade = ((log_var - log_var.min()) / max(np.ptp(log_var), 1e-12)).reshape(shape)
+    overlay = np.zeros((*shape, 4))
+    overlay[..., 3] = 0.6 * shade
+    ax.imshow(overlay, origin="lower", extent=extent, aspect="auto")
+    if regions is not None:
+        regions(ax, g0, g1, postures)
+    ax.plot(model.Z_[:, 0], model.Z_[:, 1], ".", color="w", ms=2)
+    ax.set_xlabel("z1")
+    ax.set_ylabel("z2")
 
 
 def save_figure(fig: Figure, out_dir: Path, name: str) -> list[Path]:

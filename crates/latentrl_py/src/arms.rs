@@ -2,19 +2,14 @@
 //! latent space) in one call. The shared argument checks, polling and result dict are in
 //! `rl.rs`; only the plant's config keys live here.
 
-use std::path::PathBuf;
-
-use ::sim::UrdfModel;
-use ::sim::arms::{ArmsConfig, ArmsLatent, ArmsPlant, Wall, learner_config, run_arms_trials as run_core};
-use latent_core::{LearnerConfig, Plant};
+use ::sim::arms::{ArmsConfig, ArmsPlant, Wall, learner_config};
+use latent_core::LearnerConfig;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{guard, sim_to_py, to_py};
-use crate::rl::{
-    RunArgs, apply_config_dict, echo_learner, float, floats, gp_map, int_in, invalid, latent_args, pack_results,
-    run_with_polling, type_name,
-};
+use crate::errors::{guard, sim_to_py};
+use crate::rl::{RunArgs, apply_config_dict, echo_learner, float, floats, invalid, type_name};
+use crate::simconfig::{echo_sim, run_latent_2d, set_sim_key, string, urdf_model};
 
 /// The plant keys of Experiment 2's config dict, in the order they are documented and echoed.
 const ARMS_KEYS: [&str; 16] = [
@@ -35,12 +30,6 @@ const ARMS_KEYS: [&str; 16] = [
     "kp",
     "kd",
 ];
-
-fn string(name: &str, value: &Bound<'_, PyAny>) -> PyResult<String> {
-    value
-        .extract()
-        .map_err(|_| invalid(format!("config[{name:?}]: expected a str, got {}", type_name(value))))
-}
 
 fn walls(value: &Bound<'_, PyAny>) -> PyResult<Vec<Wall>> {
     let rows: Vec<Bound<'_, PyAny>> = value
@@ -82,14 +71,7 @@ fn apply_config(config: Option<&Bound<'_, PyDict>>) -> PyResult<(ArmsConfig, Lea
             "left_hand" => plant.left_hand = string(key, v)?,
             "right_hand" => plant.right_hand = string(key, v)?,
             "start_posture" => plant.start_posture = floats(key, v)?,
-            "dt" => plant.sim.dt = float(key, v)?,
-            "substeps" => plant.sim.substeps = int_in("config[\"substeps\"]", v, 1, 1_000_000)? as usize,
-            "solver_iterations" => {
-                plant.sim.solver_iterations = int_in("config[\"solver_iterations\"]", v, 1, 1000)? as usize
-            }
-            "kp" => plant.sim.gains.kp = float(key, v)?,
-            "kd" => plant.sim.gains.kd = float(key, v)?,
-            _ => return Ok(false),
+            _ => return set_sim_key(&mut plant.sim, key, v),
         }
         Ok(true)
     })?;
@@ -116,27 +98,9 @@ fn echo_config<'py>(py: Python<'py>, plant: &ArmsConfig, learner: &LearnerConfig
     d.set_item("left_hand", &plant.left_hand)?;
     d.set_item("right_hand", &plant.right_hand)?;
     d.set_item("start_posture", plant.start_posture.to_vec())?;
-    d.set_item("dt", plant.sim.dt)?;
-    d.set_item("substeps", plant.sim.substeps)?;
-    d.set_item("solver_iterations", plant.sim.solver_iterations)?;
-    d.set_item("kp", plant.sim.gains.kp)?;
-    d.set_item("kd", plant.sim.gains.kd)?;
+    echo_sim(&d, &plant.sim)?;
     echo_learner(&d, learner)?;
     Ok(d)
-}
-
-/// A URDF given as a path (str or os.PathLike) or as the XML text itself (a str starting
-/// with "<").
-fn urdf_model(urdf: &Bound<'_, PyAny>) -> PyResult<UrdfModel> {
-    if let Ok(text) = urdf.extract::<String>()
-        && text.trim_start().starts_with('<')
-    {
-        return UrdfModel::parse(&text).map_err(sim_to_py);
-    }
-    let path: PathBuf = urdf
-        .extract()
-        .map_err(|_| invalid(format!("urdf: expected a path or URDF text, got {}", type_name(urdf))))?;
-    UrdfModel::from_file(path).map_err(sim_to_py)
 }
 
 /// Runs Experiment 2 (SPEC §4.2, paper Fig. 6) trials in parallel in Rust: two planar arms
@@ -195,31 +159,17 @@ pub fn run_arms_trials<'py>(
         let run = RunArgs { n_trials, episodes, base_seed, first_trial, config, record_episodes, test_episodes,
                             record_test_episodes, return_weights, progress }.check()?;
         let (plant, learner_config) = apply_config(run.config.as_ref())?;
-        let (decoder, encoder) = (Some(decoder), Some(encoder));
-        let latent = latent_args(
-            gp_map("decoder", &decoder)?,
-            gp_map("encoder", &encoder)?,
-            Some(latent_low),
-            Some(latent_high),
-            "for the arms",
-        )?;
         let model = urdf_model(urdf)?;
-        // Builds one plant and the learner before any thread starts: bad links, limits or
-        // dimensions fail here with the plant's own message.
-        let probe = ArmsPlant::new(model.clone(), plant.clone()).map_err(sim_to_py)?;
-        let arms_latent = ArmsLatent {
-            decoder: latent.decoder,
-            encoder: latent.encoder,
-            low: &latent.low,
-            high: &latent.high,
-        };
-        let (template, _) = arms_latent.build(&learner_config, probe.posture_dim()).map_err(to_py)?;
-        drop(probe);
-        let options = &run.options;
-        let results = run_with_polling(py, options, run.progress.as_ref(), |cancel, done| {
-            run_core(&model, &plant, &learner_config, &arms_latent, options, cancel, done)
-        })?;
-        let out = pack_results(py, &results, &template, options, 4)?;
+        let make_plant = |_| ArmsPlant::new(model.clone(), plant.clone());
+        let out = run_latent_2d(
+            py,
+            &run,
+            [decoder, encoder],
+            [latent_low, latent_high],
+            "for the arms",
+            &learner_config,
+            make_plant,
+        )?;
         out.set_item("config", echo_config(py, &plant, &learner_config)?)?;
         Ok(out)
     })

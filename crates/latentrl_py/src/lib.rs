@@ -6,9 +6,11 @@ mod convert;
 mod errors;
 mod gp;
 mod humanoid;
+mod lift;
 mod physics;
 mod rl;
 mod sim;
+mod simconfig;
 
 use pyo3::prelude::*;
 
@@ -24,6 +26,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(humanoid::humanoid_fall_check, m)?)?;
     m.add_function(wrap_pyfunction!(rl::run_bimanual_trials, m)?)?;
     m.add_function(wrap_pyfunction!(arms::run_arms_trials, m)?)?;
+    m.add_function(wrap_pyfunction!(lift::run_lift_trials, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

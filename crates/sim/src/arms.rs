@@ -24,15 +24,14 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
-use latent_core::GpMap;
-use latent_core::episode::{EndReason, Learner, LearnerConfig, Plant, StartMode, StateSpace, StepOutcome};
+use latent_core::episode::{EndReason, LearnerConfig, Plant, StartMode, StepOutcome};
 use latent_core::error::{CoreError, Result as CoreResult};
-use latent_core::policy::orthogonal_and_diagonal_actions_2d;
 use latent_core::td::TdConfig;
-use latent_core::trials::{TrialOptions, TrialResult, run_trials};
+use latent_core::trials::{TrialOptions, TrialResult};
 use rand::Rng;
 
 use crate::error::{Result, SimError, check_finite};
+use crate::latent::{Latent2d, run_latent_trials};
 use crate::plant::{Frame, PhysicsSim, SimOptions};
 use crate::urdf::UrdfModel;
 
@@ -334,44 +333,12 @@ pub fn learner_config() -> LearnerConfig {
     }
 }
 
-/// The latent space of an Experiment 2 learner: GPLVM maps and the latent box (d = 2).
-#[derive(Debug, Clone, Copy)]
-pub struct ArmsLatent<'a> {
-    /// Latent → posture GP map (GPLVM mean, Eq. 4).
-    pub decoder: &'a GpMap,
-    /// Posture → latent GP map (out-of-sample GP).
-    pub encoder: &'a GpMap,
-    /// Lower corner of the latent box.
-    pub low: &'a [f64],
-    /// Upper corner of the latent box.
-    pub high: &'a [f64],
-}
-
-impl<'a> ArmsLatent<'a> {
-    /// The latent learner (8 actions: orthogonal + diagonal, paper Exp. 2; RBF grid over the
-    /// box) and its state space for a plant with `posture_dim` joints.
-    pub fn build(&self, config: &LearnerConfig, posture_dim: usize) -> CoreResult<(Learner, StateSpace<'a>)> {
-        if self.low.len() != 2 {
-            return Err(CoreError::Shape {
-                what: "latent box (Experiment 2's 8 actions are 2-D)",
-                expected: "dimension 2".to_string(),
-                got: format!("dimension {}", self.low.len()),
-            });
-        }
-        let learner = Learner::new(config, self.low, self.high, &orthogonal_and_diagonal_actions_2d())?;
-        let space = StateSpace::Latent {
-            decoder: self.decoder,
-            encoder: self.encoder,
-        };
-        learner.check_space(&space, posture_dim)?;
-        Ok((learner, space))
-    }
-}
+/// The latent space of an Experiment 2 learner: GPLVM maps and the latent box (d = 2; 8
+/// actions, orthogonal + diagonal, paper Exp. 2).
+pub type ArmsLatent<'a> = Latent2d<'a>;
 
 /// Runs Experiment 2 trials (SPEC §4.2) in parallel, one physics world per trial: see
-/// [`latent_core::trials::run_trials`] for seeding, cancellation, progress and test
-/// episodes. The plant is built once up front, so a bad model or configuration fails
-/// before any trial starts (as [`CoreError::Plant`]).
+/// [`crate::latent::run_latent_trials`].
 pub fn run_arms_trials(
     model: &UrdfModel,
     plant: &ArmsConfig,
@@ -381,12 +348,14 @@ pub fn run_arms_trials(
     cancel: &AtomicBool,
     done: &AtomicUsize,
 ) -> CoreResult<Vec<TrialResult>> {
-    let make_plant =
-        |_| ArmsPlant::new(model.clone(), plant.clone()).map_err(|e| CoreError::Plant { reason: e.to_string() });
-    let probe = make_plant(0)?;
-    let (template, space) = latent.build(config, probe.posture_dim())?;
-    drop(probe);
-    run_trials(&template, &space, make_plant, options, cancel, done)
+    run_latent_trials(
+        |_| ArmsPlant::new(model.clone(), plant.clone()),
+        config,
+        latent,
+        options,
+        cancel,
+        done,
+    )
 }
 
 #[cfg(test)]

@@ -38,7 +38,7 @@ from latentrl.experiments.presets import check_floats, check_ints, latent_box
 from latentrl.experiments.runner import Setup, run_rl
 from latentrl.gplvm import GPLVM
 from latentrl.pca import PCA
-from latentrl.plots import hand_paths, learning_curves, save_figure
+from latentrl.plots import hand_paths, latent_value_panel, learning_curves, save_figure, value_function
 
 TARGET = np.array([-0.05, 0.47, 0.05, 0.47])
 """h* (ours, SPEC §4.2 table): left hand (−0.05, 0.47), right hand (0.05, 0.47)."""
@@ -252,26 +252,6 @@ def in_walls(hands: NDArray[np.float64]) -> NDArray[np.bool_]:
     return inside
 
 
-def value_function(
-    weights: NDArray[np.float64],
-    low: NDArray[np.float64],
-    high: NDArray[np.float64],
-    points: NDArray[np.float64],
-) -> NDArray[np.float64]:
-    """V(z) = Σ w_i b_i(z) at `points` (M, 2) with dense normalised RBFs (σ = spacing) on the
-    learner's grid, flat index with dimension 0 fastest (as the Rust grid). The learner's
-    3σ cut-off changes V by less than the Rust tests' stated tolerance."""
-    n = int(round(np.sqrt(weights.size)))
-    axes = [np.linspace(lo, hi, n) for lo, hi in zip(low, high)]
-    c0, c1 = np.meshgrid(axes[0], axes[1], indexing="xy")
-    centres = np.column_stack([c0.ravel(), c1.ravel()])
-    sigma = (high - low) / (n - 1)
-    d2 = (((points[:, None, :] - centres[None, :, :]) / sigma) ** 2).sum(axis=-1)
-    phi = np.exp(-0.5 * (d2 - d2.min(axis=1, keepdims=True)))
-    values: NDArray[np.float64] = (phi @ weights) / phi.sum(axis=1)
-    return values
-
-
 def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
     """Fig. 5, 6a, 6b, 6c, 6d into `out` (PNG + PDF)."""
     fitted = fit(preset)
@@ -310,34 +290,19 @@ def _walls(ax: Axes) -> None:
 
 
 def _latent_panel(ax: Axes, fitted: Fitted, weights: NDArray[np.float64], grid: int = 120) -> None:
-    """V over the latent box, GPLVM variance shaded (darker = higher, log scale), corridor
-    mapped into latent space (black: decoded hands in a wall), grip broken > 5 mm (red line),
-    target region (dashed white), demonstrations' latent points (white dots)."""
-    low, high = fitted.low, fitted.high
-    g0, g1 = np.meshgrid(np.linspace(low[0], high[0], grid), np.linspace(low[1], high[1], grid))
-    points = np.column_stack([g0.ravel(), g1.ravel()])
-    postures, variance = fitted.model.decoder_.predict(points)
-    hands = arms_forward(postures)
-    shape = g0.shape
-    value = value_function(weights, low, high, points).reshape(shape)
-    extent = (low[0], high[0], low[1], high[1])
-    image = ax.imshow(value, origin="lower", extent=extent, aspect="auto", cmap="viridis")
-    plt.colorbar(image, ax=ax, label="V")
-    # Log scale: the variance spans orders of magnitude from the demonstrations to the corners.
-    log_var = np.log(np.maximum(variance, 1e-300))
-    shade = ((log_var - log_var.min()) / max(np.ptp(log_var), 1e-12)).reshape(shape)
-    overlay = np.zeros((*shape, 4))
-    overlay[..., 3] = 0.6 * shade
-    ax.imshow(overlay, origin="lower", extent=extent, aspect="auto")
-    walls = in_walls(hands).reshape(shape)
-    ax.contourf(g0, g1, walls.astype(float), levels=[0.5, 1.5], colors="k")
-    drop = grip_error(hands, test="vector").reshape(shape)
-    ax.contour(g0, g1, drop, levels=[GRIP_TEST_TOLERANCE], colors="r", linewidths=1)
-    rms = np.sqrt(((hands - TARGET) ** 2).sum(axis=1) / 2).reshape(shape)
-    ax.contour(g0, g1, rms, levels=[0.05], colors="w", linestyles="--", linewidths=1)
-    ax.plot(fitted.model.Z_[:, 0], fitted.model.Z_[:, 1], ".", color="w", ms=2)
-    ax.set_xlabel("z1")
-    ax.set_ylabel("z2")
+    """`plots.latent_value_panel` with the corridor mapped into latent space (black: decoded
+    hands in a wall), grip broken > 5 mm (red line) and the target region (dashed white)."""
+
+    def regions(ax: Axes, g0: NDArray[np.float64], g1: NDArray[np.float64], postures: NDArray[np.float64]) -> None:
+        hands = arms_forward(postures)
+        walls = in_walls(hands).reshape(g0.shape)
+        ax.contourf(g0, g1, walls.astype(float), levels=[0.5, 1.5], colors="k")
+        drop = grip_error(hands, test="vector").reshape(g0.shape)
+        ax.contour(g0, g1, drop, levels=[GRIP_TEST_TOLERANCE], colors="r", linewidths=1)
+        rms = np.sqrt(((hands - TARGET) ** 2).sum(axis=1) / 2).reshape(g0.shape)
+        ax.contour(g0, g1, rms, levels=[0.05], colors="w", linestyles="--", linewidths=1)
+
+    latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, regions=regions, grid=grid)
 
 
 def _fig5(preset: Exp2Preset, fitted: Fitted, out: Path) -> None:
