@@ -15,7 +15,7 @@ help: ## list the targets
 $(VENV)/.deps: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib tqdm gymnasium pytest pytest-timeout hypothesis mypy
+	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib tqdm gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm scikit-learn pandas "ray>=2.9"
 	touch $@
 
 $(VENV)/.built: $(VENV)/.deps Cargo.toml Cargo.lock $(shell find crates python -name '*.rs' -o -name '*.toml' -o -name '*.py' 2>/dev/null)
@@ -46,10 +46,11 @@ bench: build ## criterion benches, the NumPy loop, GPy and MuJoCo comparisons (J
 	benches/.venv-bench/bin/python benches/bench_gp.py
 	benches/.venv-bench/bin/python benches/bench_sim.py
 
-lint: build ## rustfmt, clippy (warnings are errors) and the native stubs against the module
+lint: build ## rustfmt, clippy (warnings are errors), the native stubs against the module, mypy --strict
 	cargo fmt --all --check
 	cargo clippy --quiet --workspace --all-targets -- -D warnings
 	$(PY) -m mypy.stubtest latentrl._native
+	$(PY) -m mypy --strict python/latentrl
 
 install-check: ## `pip install .` into a fresh venv as a user would, then use the installed package from outside the tree
 	rm -rf $(INSTALL_VENV)
@@ -69,7 +70,7 @@ fuzz: ## cargo fuzz the URDF parser + physics for FUZZ_SECONDS (180) s; FUZZ_TAR
 	@command -v cargo-fuzz > /dev/null || cargo install --locked cargo-fuzz
 	mkdir -p fuzz/corpus/$(FUZZ_TARGET)
 	RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(CURDIR)/fuzz/target nice -n 10 cargo fuzz run --sanitizer none $(FUZZ_TARGET) \
-		fuzz/corpus/$(FUZZ_TARGET) fuzz/seeds -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 -dict=fuzz/urdf.dict \
+		fuzz/corpus/$(FUZZ_TARGET) python/latentrl/data -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 -dict=fuzz/urdf.dict \
 		-print_final_stats=1
 
 clean: ## remove the venv and build outputs

@@ -1,5 +1,5 @@
-"""The `latentrl` command: run an experiment, fit a model to demonstrations, redraw the figures
-of a results directory, show versions.
+"""The `latentrl` command: run an experiment or a sweep of it (locally or on a Ray cluster), fit
+a model to demonstrations, redraw the figures of a results directory, show versions.
 
 Exit codes: 0 done, 1 bad values or a failed run (the message says what), 2 bad arguments
 (argparse), 130 interrupted (finished trials are kept; `latentrl run EXP --resume DIR`
@@ -12,36 +12,13 @@ import argparse
 import dataclasses
 import json
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any
 
 from latentrl.experiments.presets import field_docs
+from latentrl.experiments.registry import experiments
 from latentrl.experiments.results import environment, read_json
-
-
-class Experiment(NamedTuple):
-    """One `latentrl run` experiment."""
-
-    preset: type
-    """Its frozen preset dataclass; every scalar field becomes a `--flag`."""
-    run: Callable[..., Any]
-    """`run(preset, out_dir, progress=...)`."""
-    figures: Callable[..., None] | None
-    """`figures(preset, arrays, out_dir)` for the RL experiments, whose runs results.json keeps
-    trial by trial: they can be resumed and re-plotted. None for the others."""
-
-
-def _experiments() -> dict[str, Experiment]:
-    """Experiment name → its preset, runner and figures."""
-    from latentrl.experiments import exp1, exp2, exp3, table1
-
-    return {
-        "table1": Experiment(table1.Table1Preset, table1.run_table1, None),
-        "exp1": Experiment(exp1.Exp1Preset, exp1.run_exp1, exp1.figures),
-        "exp2": Experiment(exp2.Exp2Preset, exp2.run_exp2, exp2.figures),
-        "exp3": Experiment(exp3.Exp3Preset, exp3.run_exp3, exp3.figures),
-    }
 
 
 def saved_run(out_dir: Path) -> tuple[str, Any]:
@@ -52,10 +29,10 @@ def saved_run(out_dir: Path) -> tuple[str, Any]:
         raise ValueError(f"{out_dir}: no results.json there, so no run of an RL experiment")
     fields = dict(read_json(meta_path).get("preset") or {})
     preset_name = fields.pop("name", None)
-    found = [name for name, exp in _experiments().items() if exp.figures and exp.preset.__name__ == preset_name]
+    found = [name for name, exp in experiments().items() if exp.rl and exp.preset.__name__ == preset_name]
     if not found:
         raise ValueError(f"{out_dir}: results.json names no RL experiment's preset (found {preset_name!r})")
-    preset_cls = _experiments()[found[0]].preset
+    preset_cls = experiments()[found[0]].preset
     unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(preset_cls)})
     if unknown:
         raise ValueError(f"{out_dir}: its preset has fields this version does not know: {unknown}")
@@ -84,11 +61,11 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     run = sub.add_parser("run", help="run an experiment and write its results directory")
     run_sub = run.add_subparsers(dest="experiment", required=True)
-    for name, exp in _experiments().items():
+    for name, exp in experiments().items():
         cmd = run_sub.add_parser(name, help=(exp.preset.__doc__ or "").strip().splitlines()[0])
         cmd.add_argument("--out", type=Path, help=f"results directory (default: results/{name})")
         cmd.add_argument("--quick", action="store_true", help="the small smoke-test preset")
-        if exp.figures:
+        if exp.rl:
             cmd.add_argument(
                 "--resume", type=Path, metavar="DIR",
                 help="continue the interrupted run in DIR with its own preset (no other preset flags)",
@@ -105,12 +82,23 @@ def build_parser() -> argparse.ArgumentParser:
     plot = sub.add_parser("plot", help="redraw the figures of a results directory (finished trials only)")
     plot.add_argument("results", type=Path, help="a results directory of `latentrl run exp1|exp2|exp3`")
     plot.add_argument("--out", type=Path, help="where to write the figures (default: the results directory)")
+    sweep = sub.add_parser("sweep", help="run an RL experiment over a grid of preset values, here or on a Ray cluster")
+    sweep.add_argument("file", type=Path, help="the sweep: a .toml file (or .yaml with PyYAML); see examples/sweep.toml")
+    sweep.add_argument("--backend", choices=("local", "ray"), default="local",
+                       help="local: trials in this process (rayon); ray: one Ray task per trial (default: local)")
+    sweep.add_argument("--address", metavar="ADDR",
+                       help="with --backend ray: 'auto' (the cluster `ray start --head` runs here), HOST:6379, or "
+                            "ray://HOST:10001 (Ray Client); default: a local Ray instance")
+    sweep.add_argument("--batch", type=int, default=1, help="with --backend ray: trials per Ray task (default: 1)")
+    sweep.add_argument("--out", type=Path, help="sweep directory (default: results/<FILE's name>)")
+    sweep.add_argument("--resume", action="store_true", help="continue the sweep in --out; finished trials are kept")
+    sweep.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     sub.add_parser("info", help="print versions, git revision and thread count as JSON")
     return parser
 
 
 def _run(args: argparse.Namespace) -> int:
-    exp = _experiments()[args.experiment]
+    exp = experiments()[args.experiment]
     overrides = {
         f.name: getattr(args, f.name) for f in dataclasses.fields(exp.preset) if getattr(args, f.name, None) is not None
     }
@@ -127,7 +115,8 @@ def _run(args: argparse.Namespace) -> int:
         if name != args.experiment:
             raise ValueError(f"{resume} holds a run of {name}, not of {args.experiment}")
     else:
-        preset = dataclasses.replace(exp.preset.quick() if args.quick else exp.preset(), **overrides)
+        base = exp.preset.quick() if args.quick else exp.preset()  # type: ignore[attr-defined]
+        preset = dataclasses.replace(base, **overrides)
     try:
         exp.run(preset, out, progress=args.progress)
     except KeyboardInterrupt:
@@ -164,12 +153,35 @@ def _plot(args: argparse.Namespace) -> int:
     arrays, done = finished_trials(load_arrays(args.results))
     if not done:
         raise ValueError(f"{args.results}: no finished trial to plot")
-    figures = _experiments()[name].figures
-    assert figures is not None  # saved_run finds RL experiments only
+    rl = experiments()[name].rl
+    assert rl is not None  # saved_run finds RL experiments only
     out = args.out or args.results
-    figures(preset, arrays, out)
+    rl.figures(preset, arrays, out)
     counts = ", ".join(f"{learner} {n} of {preset.trials}" for learner, n in done.items())
     print(f"figures of {name} ({counts} trials) in {out}")
+    return 0
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from latentrl.experiments.ray_backend import RayBackend
+    from latentrl.experiments.sweep import SweepError, load_sweep, run_sweep
+
+    if args.backend != "ray" and (args.address is not None or args.batch != 1):
+        raise ValueError("--address and --batch are options of --backend ray")
+    sweep = load_sweep(args.file)
+    out = args.out or Path("results") / args.file.stem
+    backend = RayBackend(address=args.address, batch=args.batch) if args.backend == "ray" else "local"
+    try:
+        run_sweep(sweep, out, backend=backend, resume=args.resume, progress=args.progress)
+    except KeyboardInterrupt:
+        print(f"interrupted; finished trials are in {out}; continue with: "
+              f"latentrl sweep {args.file} --out {out} --resume", file=sys.stderr)
+        return 130
+    except SweepError as err:
+        print(f"latentrl: error: {err}", file=sys.stderr)
+        return 1
+    print((out / "summary.md").read_text(), end="")
+    print(f"results of every cell in {out}/<cell>/; summary in {out}/summary.md and sweep.png")
     return 0
 
 
@@ -179,7 +191,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "info":
         print(json.dumps(environment(), indent=2))
         return 0
-    command = {"run": _run, "fit": _fit, "plot": _plot}[args.command]
+    command = {"run": _run, "fit": _fit, "plot": _plot, "sweep": _sweep}[args.command]
     try:
         return command(args)
     except (ValueError, OSError) as err:

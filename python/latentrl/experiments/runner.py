@@ -10,7 +10,7 @@ in the same directory is an error.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
@@ -67,11 +67,14 @@ RunTrials = Callable[..., dict[str, Any]]
 
 
 class Preset(Protocol):
-    """What the runner needs of a preset."""
+    """What the runner needs of a preset (a frozen dataclass: read-only fields)."""
 
-    trials: int
-    episodes: int
-    seed: int
+    @property
+    def trials(self) -> int: ...
+    @property
+    def episodes(self) -> int: ...
+    @property
+    def seed(self) -> int: ...
 
     def validate(self) -> None:
         """ValueError naming the first impossible field."""
@@ -85,6 +88,29 @@ class Setup:
     info: dict[str, Any] = field(default_factory=dict)
 
 
+#: Runs chunks of trials `(learner, first, count)` of a setup and yields each chunk with its
+#: native call's dict as it finishes (in any order); `advance(episodes)` moves the progress bar.
+Execute = Callable[
+    [Setup, list[tuple[str, int, int]], Callable[[int], object]],
+    Iterable[tuple[str, int, int, dict[str, Any]]],
+]
+
+
+def run_in_process(
+    built: Setup, chunks: list[tuple[str, int, int]], advance: Callable[[int], object]
+) -> Iterator[tuple[str, int, int, dict[str, Any]]]:
+    """The default `Execute`: one chunk after the other in this process, rayon running the
+    chunk's trials in parallel."""
+    for name, first, n in chunks:
+        seen = [0]
+
+        def report(done: int, _total: int, seen: list[int] = seen) -> None:
+            advance(done - seen[0])
+            seen[0] = done
+
+        yield name, first, n, built.learners[name](first_trial=first, n_trials=n, progress=report)
+
+
 def run_rl(
     preset: Preset,
     out_dir: Path | str,
@@ -93,8 +119,11 @@ def run_rl(
     figures: Callable[[Any, Mapping[str, np.ndarray], Path], None],
     progress: bool = True,
     chunk: int | None = None,
+    execute: Execute = run_in_process,
 ) -> dict[str, Any]:
-    """Runs (or continues) `preset` into `out_dir`; returns the metadata written to results.json."""
+    """Runs (or continues) `preset` into `out_dir`; returns the metadata written to results.json.
+    `execute` runs the chunks (elsewhere, e.g. on a Ray cluster: `latentrl.experiments.sweep`);
+    each finished chunk is stored and saved here as it arrives."""
     preset.validate()
     out = Path(out_dir)
     meta_path, arrays_path = out / "results.json", out / "returns.npz"
@@ -117,13 +146,7 @@ def run_rl(
     bar = tqdm(total=len(todo) * preset.episodes, unit="ep", disable=not progress, desc="episodes")
     meta.setdefault("trials", {})
     try:
-        for name, first, n in _chunks(todo, chunk):
-            done_before = bar.n
-
-            def report(done: int, _total: int, base: int = done_before) -> None:
-                bar.update(base + done - bar.n)
-
-            result = built.learners[name](first_trial=first, n_trials=n, progress=report)
+        for name, first, n, result in execute(built, _chunks(todo, chunk), bar.update):
             for i, t in enumerate(range(first, first + n)):
                 for key in PER_EPISODE:
                     arrays[array_key(name, key)][t] = result[key][i]
