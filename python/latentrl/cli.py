@@ -29,14 +29,16 @@ def saved_run(out_dir: Path) -> tuple[str, Any]:
         raise ValueError(f"{out_dir}: no results.json there, so no run of an RL experiment")
     fields = dict(read_json(meta_path).get("preset") or {})
     preset_name = fields.pop("name", None)
-    found = [name for name, exp in experiments().items() if exp.rl and exp.preset.__name__ == preset_name]
+    found = [
+        (name, exp.preset) for name, exp in experiments().items() if exp.rl and exp.preset.__name__ == preset_name
+    ]
     if not found:
         raise ValueError(f"{out_dir}: results.json names no RL experiment's preset (found {preset_name!r})")
-    preset_cls = experiments()[found[0]].preset
+    name, preset_cls = found[0]
     unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(preset_cls)})
     if unknown:
         raise ValueError(f"{out_dir}: its preset has fields this version does not know: {unknown}")
-    return found[0], preset_cls(**fields)
+    return name, preset_cls(**fields)
 
 
 def _add_preset_flags(parser: argparse.ArgumentParser, preset_cls: type) -> None:

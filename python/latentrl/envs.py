@@ -402,11 +402,11 @@ class HumanoidLiftEnv(gym.Env[Obs, Obs]):
         self.joint_names = self.sim.joint_names
         demos = load_demos(humanoid.demos_path(), expected_joints=self.joint_names).postures
         self.start_posture = demos[0]
-        heights = []
+        standing_hands = []
         for pose in demos:
             self.sim.reset_on_ground(pose, self.soles[0])
-            heights.append((self.hands()[[2, 5]].mean(), self.hands()))
-        self.target = max(heights, key=lambda item: float(item[0]))[1]
+            standing_hands.append(self.hands())
+        self.target = max(standing_hands, key=lambda hands: float(hands[[2, 5]].mean()))
         n = len(self.joint_names)
         self.action_space = spaces.Box(-max_step, max_step, (n,), np.float64)
         limits = humanoid.model()

@@ -22,16 +22,13 @@
 //! bottom) at the reset and both above it (`y >` the highest wall top) after some step.
 //! Frozen test episodes start only below the band ([`Plant::admits_test_start`]).
 
-use std::sync::atomic::{AtomicBool, AtomicUsize};
-
 use latent_core::episode::{EndReason, LearnerConfig, Plant, StartMode, StepOutcome};
-use latent_core::error::{CoreError, Result as CoreResult};
+use latent_core::error::CoreError;
 use latent_core::td::TdConfig;
-use latent_core::trials::{TrialOptions, TrialResult};
 use rand::Rng;
 
 use crate::error::{Result, SimError, check_finite};
-use crate::latent::{Latent2d, run_latent_trials};
+use crate::latent::Latent2d;
 use crate::plant::{Frame, PhysicsSim, SimOptions};
 use crate::urdf::UrdfModel;
 
@@ -336,27 +333,6 @@ pub fn learner_config() -> LearnerConfig {
 /// The latent space of an Experiment 2 learner: GPLVM maps and the latent box (d = 2; 8
 /// actions, orthogonal + diagonal, paper Exp. 2).
 pub type ArmsLatent<'a> = Latent2d<'a>;
-
-/// Runs Experiment 2 trials (SPEC §4.2) in parallel, one physics world per trial: see
-/// [`crate::latent::run_latent_trials`].
-pub fn run_arms_trials(
-    model: &UrdfModel,
-    plant: &ArmsConfig,
-    config: &LearnerConfig,
-    latent: &ArmsLatent<'_>,
-    options: &TrialOptions,
-    cancel: &AtomicBool,
-    done: &AtomicUsize,
-) -> CoreResult<Vec<TrialResult>> {
-    run_latent_trials(
-        |_| ArmsPlant::new(model.clone(), plant.clone()),
-        config,
-        latent,
-        options,
-        cancel,
-        done,
-    )
-}
 
 #[cfg(test)]
 mod tests {

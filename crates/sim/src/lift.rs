@@ -28,18 +28,14 @@
 //! non-sole link on the floor or a tilted sole, or stands with its centre of mass less
 //! than `min_start_margin` inside the support polygon ([`EndReason::Fall`]).
 
-use std::sync::atomic::{AtomicBool, AtomicUsize};
-
 use latent_core::episode::{EndReason, LearnerConfig, Plant, StartMode, StepOutcome};
-use latent_core::error::{CoreError, Result as CoreResult};
+use latent_core::error::CoreError;
 use latent_core::td::TdConfig;
-use latent_core::trials::{TrialOptions, TrialResult};
 use nalgebra::Isometry3;
 use rand::{Rng, RngExt};
 
 use crate::error::{Result, SimError, check_finite};
 use crate::humanoid::{reset_on_ground, support_margin};
-use crate::latent::{Latent2d, run_latent_trials};
 use crate::obstacles::{FallCriteria, Obstacle, ObstacleShape};
 use crate::pd::PdGains;
 use crate::plant::{Frame, PhysicsSim, SimOptions};
@@ -400,27 +396,6 @@ pub fn learner_config() -> LearnerConfig {
         start: StartMode::UniformInBox,
         ..LearnerConfig::default()
     }
-}
-
-/// Runs Experiment 3 trials (SPEC §4.3) in parallel, one plant per trial (and a fresh world
-/// per episode): see [`crate::latent::run_latent_trials`].
-pub fn run_lift_trials(
-    model: &UrdfModel,
-    plant: &LiftConfig,
-    config: &LearnerConfig,
-    latent: &Latent2d<'_>,
-    options: &TrialOptions,
-    cancel: &AtomicBool,
-    done: &AtomicUsize,
-) -> CoreResult<Vec<TrialResult>> {
-    run_latent_trials(
-        |_| LiftPlant::new(model.clone(), plant.clone()),
-        config,
-        latent,
-        options,
-        cancel,
-        done,
-    )
 }
 
 #[cfg(test)]

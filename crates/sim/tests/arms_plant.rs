@@ -9,7 +9,8 @@ use latent_core::trials::{TrialOptions, TrialResult};
 use latent_core::{GpMap, SeKernel};
 use nalgebra::DMatrix;
 use sim::PlanarArms;
-use sim::arms::{ArmsConfig, ArmsLatent, ArmsPlant, run_arms_trials};
+use sim::arms::{ArmsConfig, ArmsLatent, ArmsPlant};
+use sim::latent::run_latent_trials;
 
 fn plant(config: ArmsConfig) -> ArmsPlant {
     ArmsPlant::new(common::arms_model(), config).expect("arms plant builds")
@@ -235,9 +236,8 @@ fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
     let model = common::arms_model();
     let results = pool
         .install(|| {
-            run_arms_trials(
-                &model,
-                &plant,
+            run_latent_trials(
+                |_| ArmsPlant::new(model.clone(), plant.clone()),
                 &config,
                 &latent,
                 &options,

@@ -10,7 +10,8 @@ use latent_core::{GpMap, SeKernel};
 use nalgebra::DMatrix;
 use sim::Latent2d;
 use sim::UrdfModel;
-use sim::lift::{LiftConfig, LiftPlant, TASK_HEAD, run_lift_trials};
+use sim::latent::run_latent_trials;
+use sim::lift::{LiftConfig, LiftPlant, TASK_HEAD};
 
 const KHR1HV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/khr1hv.urdf");
 
@@ -190,9 +191,8 @@ fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
     let results = pool
         .install(|| {
             let cancel = AtomicBool::new(false);
-            run_lift_trials(
-                &model(),
-                &LiftConfig::default(),
+            run_latent_trials(
+                |_| LiftPlant::new(model(), LiftConfig::default()),
                 &config,
                 &latent,
                 &options,
