@@ -52,13 +52,16 @@ lint: build ## rustfmt, clippy (warnings are errors), the native stubs against t
 	$(PY) -m mypy.stubtest latentrl._native
 	$(PY) -m mypy --strict python/latentrl
 
-install-check: ## `pip install .` into a fresh venv as a user would, then use the installed package from outside the tree
+install-check: ## `pip install .` into a fresh venv as a user would, then use the installed package from outside the tree, without and with the [plot] extra
 	rm -rf $(INSTALL_VENV)
 	$(PYTHON) -m venv $(INSTALL_VENV)
 	$(INSTALL_VENV)/bin/python -m pip install --quiet --upgrade pip
 	$(INSTALL_VENV)/bin/python -m pip install --quiet .
 	cd $(INSTALL_VENV) && bin/python -c "import sys, latentrl; sys.exit(latentrl.__file__.startswith('$(CURDIR)/python'))"
 	cd $(INSTALL_VENV) && bin/python -m latentrl info > /dev/null
+	cd $(INSTALL_VENV) && bin/python -c "import importlib.util, sys; sys.exit(importlib.util.find_spec('matplotlib') is not None)"
+	cd $(INSTALL_VENV) && bin/python $(CURDIR)/tests/core_without_matplotlib.py
+	$(INSTALL_VENV)/bin/python -m pip install --quiet "latentrl[plot]"
 	cd $(INSTALL_VENV) && bin/latentrl run exp2 --quick --no-progress --trials 1 --episodes 2 --steps 10 \
 		--test-episodes 1 --fig5-samples 50 --gplvm-max-iter 20 --out run
 	cd $(INSTALL_VENV) && test -s run/results.json && test -s run/fig6a.png && echo "install-check: pip install . works"

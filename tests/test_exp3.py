@@ -12,7 +12,7 @@ import pytest
 
 from latentrl import humanoid
 from latentrl._native import InvalidInputError, run_lift_trials
-from latentrl.experiments import exp3
+from latentrl.experiments import exp3, exp3_figures
 from latentrl.experiments.exp3 import Exp3Preset, run_exp3
 from latentrl.experiments.results import write_npz
 
@@ -80,7 +80,7 @@ def test_records_postures_and_echoes_the_config(fitted):
     np.testing.assert_allclose(np.linalg.norm(start[:, 9:13], axis=1), 1.0, atol=1e-6)
     # The recorded base pose and joints give the recorded hands through the NumPy kinematics.
     for row in start:
-        poses = h.link_poses(row[exp3.TASK_HEAD:], exp3._base(row))
+        poses = h.link_poses(row[exp3.TASK_HEAD:], exp3_figures._base(row))
         np.testing.assert_allclose(poses["l_hand"][:3, 3], row[:3], atol=2e-3)
     config = a["config"]
     assert config["obstacles"] == [list(exp3.OBSTACLE)] and config["solver_iterations"] == 4

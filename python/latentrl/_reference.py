@@ -1,5 +1,6 @@
 """Plain-NumPy reference versions of the GP maths (dense, with `np.linalg`): the SE kernel
-(paper Eq. 2), GP prediction (Eq. 4) and the GPLVM objective and gradient (Eq. 1, 3).
+(paper Eq. 2), GP prediction (Eq. 4) and the GPLVM objective and gradient (Eq. 1, 3), the
+normalised RBF features, the TD(0) step and a learner's value function over its latent grid.
 Tests check the Rust core against them; benches use them as the baseline."""
 
 from __future__ import annotations
@@ -75,3 +76,23 @@ def td0_update(weights: Array, b: Array, reward: float, v_next: float, alpha: fl
     delta = reward + gamma * v_next - weights @ b
     weights += alpha * delta * b
     return float(delta)
+
+
+def value_function(
+    weights: NDArray[np.float64],
+    low: NDArray[np.float64],
+    high: NDArray[np.float64],
+    points: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """V(z) = Σ w_i b_i(z) at `points` (M, 2) with dense normalised RBFs (σ = spacing) on the
+    learner's grid, flat index with dimension 0 fastest (as the Rust grid). The learner's
+    3σ cut-off changes V by less than the Rust tests' stated tolerance."""
+    n = int(round(np.sqrt(weights.size)))
+    axes = [np.linspace(lo, hi, n) for lo, hi in zip(low, high)]
+    c0, c1 = np.meshgrid(axes[0], axes[1], indexing="xy")
+    centres = np.column_stack([c0.ravel(), c1.ravel()])
+    sigma = (high - low) / (n - 1)
+    d2 = (((points[:, None, :] - centres[None, :, :]) / sigma) ** 2).sum(axis=-1)
+    phi = np.exp(-0.5 * (d2 - d2.min(axis=1, keepdims=True)))
+    values: NDArray[np.float64] = (phi @ weights) / phi.sum(axis=1)
+    return values

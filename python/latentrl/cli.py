@@ -199,6 +199,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ValueError, OSError) as err:
         print(f"latentrl: error: {err}", file=sys.stderr)
         return 1
+    except ModuleNotFoundError as err:
+        if err.name != "matplotlib":
+            raise
+        print("latentrl: error: figures need matplotlib: pip install 'latentrl[plot]'", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

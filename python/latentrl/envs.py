@@ -59,10 +59,19 @@ def _posture_option(options: dict[str, Any] | None, n: int = 4) -> Obs | None:
 
 
 def _check_render_mode(render_mode: str | None, modes: list[str]) -> str | None:
-    """`render_mode` if it is None or one of `modes`, else a ValueError."""
+    """`render_mode` if it is None or one of `modes` (these need matplotlib), else a ValueError."""
     if render_mode not in (None, *modes):
         raise ValueError(f"render_mode must be None or one of {modes}, got {render_mode!r}")
+    if render_mode is not None:
+        try:
+            import matplotlib  # noqa: F401
+        except ModuleNotFoundError as err:
+            raise ModuleNotFoundError(
+                f"render_mode={render_mode!r} draws with matplotlib: pip install 'latentrl[plot]'",
+                name="matplotlib",
+            ) from err
     return render_mode
+
 
 class BimanualReachEnv(gym.Env[Obs, Obs]):
     """Two planar hands carrying an object to a target (paper Sec. IV-A, SPEC §4.1).

@@ -19,6 +19,7 @@ from matplotlib.patches import Circle  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
 from latentrl._base import atomic_write  # noqa: E402
+from latentrl._reference import value_function  # noqa: E402
 
 
 def running_mean(values: NDArray[np.float64], window: int) -> NDArray[np.float64]:
@@ -67,26 +68,6 @@ def hand_paths(
     ax.set_aspect("equal")
     ax.set_xlabel("x")
     ax.set_ylabel("y")
-
-
-def value_function(
-    weights: NDArray[np.float64],
-    low: NDArray[np.float64],
-    high: NDArray[np.float64],
-    points: NDArray[np.float64],
-) -> NDArray[np.float64]:
-    """V(z) = Σ w_i b_i(z) at `points` (M, 2) with dense normalised RBFs (σ = spacing) on the
-    learner's grid, flat index with dimension 0 fastest (as the Rust grid). The learner's
-    3σ cut-off changes V by less than the Rust tests' stated tolerance."""
-    n = int(round(np.sqrt(weights.size)))
-    axes = [np.linspace(lo, hi, n) for lo, hi in zip(low, high)]
-    c0, c1 = np.meshgrid(axes[0], axes[1], indexing="xy")
-    centres = np.column_stack([c0.ravel(), c1.ravel()])
-    sigma = (high - low) / (n - 1)
-    d2 = (((points[:, None, :] - centres[None, :, :]) / sigma) ** 2).sum(axis=-1)
-    phi = np.exp(-0.5 * (d2 - d2.min(axis=1, keepdims=True)))
-    values: NDArray[np.float64] = (phi @ weights) / phi.sum(axis=1)
-    return values
 
 
 #: Draws an experiment's regions on a latent panel: `regions(ax, g0, g1, postures)` with the

@@ -7,13 +7,11 @@ A full-space learner (4-D hand positions, 12 actions, 20⁴ RBFs) against a late
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 from typing import Any
 
-import matplotlib.pyplot as plt
 import numpy as np
 
 from latentrl import _native
@@ -21,7 +19,6 @@ from latentrl.datasets import bimanual_pairs
 from latentrl.experiments.presets import check_floats, check_ints, latent_box
 from latentrl.experiments.runner import RunTrials, Setup, run_rl
 from latentrl.gplvm import GPLVM
-from latentrl.plots import hand_paths, learning_curves, save_figure
 
 TARGET = np.array([0.0, 0.0, 0.1, 0.0])
 """x* of the reward (paper): left hand at the origin, right hand 0.1 to its right."""
@@ -157,25 +154,8 @@ def setup(preset: Exp1Preset) -> Setup:
     return Setup(learners=learners, info=info)
 
 
-def figures(preset: Exp1Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
-    """Fig. 4a (learning curves), 4b (hand paths during learning), 4c (after learning)."""
-    fig, ax = plt.subplots(figsize=(6, 4))
-    learning_curves(ax, {name: arrays[name] for name in ("latent", "full") if name in arrays})
-    ax.set_title("Exp 1: bimanual reaching, mean ± s.d. over trials")
-    save_figure(fig, out, "fig4a")
-    record = recorded_episodes(preset.episodes)
-    disc = ((*OBSTACLE_CENTRE, preset.obstacle_radius),)
-    for name, episodes in (("fig4b", record[:3]), ("fig4c", record[-3:])):
-        fig, axes = plt.subplots(1, 2, figsize=(9, 4.5), sharex=True, sharey=True)
-        for ax, learner in zip(axes, ("latent", "full")):
-            paths = arrays.get(f"{learner}_paths")
-            if paths is None:
-                continue
-            hand_paths(ax, paths[0, [record.index(e) for e in episodes]], target=TARGET, discs=disc)
-            ax.set_title(f"{learner}: episodes {', '.join(str(e + 1) for e in episodes)} (trial 1)")
-        save_figure(fig, out, name)
-
-
 def run_exp1(preset: Exp1Preset, out_dir: Path | str, *, progress: bool = True) -> dict[str, Any]:
     """Runs (or continues) Experiment 1 into `out_dir` (results.json, returns.npz, fig4*)."""
+    from latentrl.experiments.exp1_figures import figures  # matplotlib: the [plot] extra
+
     return run_rl(preset, out_dir, setup=setup, figures=figures, progress=progress)

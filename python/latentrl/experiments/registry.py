@@ -3,6 +3,7 @@ the RL experiments what a sweep, a resume or a re-plot needs."""
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -20,10 +21,15 @@ class RlExperiment(NamedTuple):
     """Its frozen preset dataclass."""
     setup: Callable[[Any], Setup]
     """`setup(preset)`: the learners and the facts results.json records."""
-    figures: Callable[[Any, Mapping[str, np.ndarray], Path], None]
-    """`figures(preset, arrays, out_dir)`."""
+    figures_module: str
+    """The module whose `figures(preset, arrays, out_dir)` draws the run's figures, imported
+    only to draw (matplotlib, the `[plot]` extra)."""
     learners: tuple[str, ...]
     """The learners `setup` builds, by name."""
+
+    def figures(self, preset: Any, arrays: Mapping[str, np.ndarray], out_dir: Path) -> None:
+        """Draws the figures of a run of `preset` from its `arrays` into `out_dir`."""
+        importlib.import_module(self.figures_module).figures(preset, arrays, out_dir)
 
 
 class Experiment(NamedTuple):
@@ -44,13 +50,13 @@ def experiments() -> dict[str, Experiment]:
     return {
         "table1": Experiment(table1.Table1Preset, table1.run_table1, None),
         "exp1": Experiment(
-            exp1.Exp1Preset, exp1.run_exp1, RlExperiment(exp1.Exp1Preset, exp1.setup, exp1.figures, ("latent", "full"))
+            exp1.Exp1Preset, exp1.run_exp1, RlExperiment(exp1.Exp1Preset, exp1.setup, "latentrl.experiments.exp1_figures", ("latent", "full"))
         ),
         "exp2": Experiment(
-            exp2.Exp2Preset, exp2.run_exp2, RlExperiment(exp2.Exp2Preset, exp2.setup, exp2.figures, ("latent",))
+            exp2.Exp2Preset, exp2.run_exp2, RlExperiment(exp2.Exp2Preset, exp2.setup, "latentrl.experiments.exp2_figures", ("latent",))
         ),
         "exp3": Experiment(
-            exp3.Exp3Preset, exp3.run_exp3, RlExperiment(exp3.Exp3Preset, exp3.setup, exp3.figures, ("latent",))
+            exp3.Exp3Preset, exp3.run_exp3, RlExperiment(exp3.Exp3Preset, exp3.setup, "latentrl.experiments.exp3_figures", ("latent",))
         ),
     }
 

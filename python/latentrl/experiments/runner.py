@@ -143,7 +143,8 @@ def run_rl(
         for t in range(preset.trials)
         if arrays[array_key(name, "ends")][t, 0] < 0
     ]
-    bar = tqdm(total=len(todo) * preset.episodes, unit="ep", disable=not progress, desc="episodes")
+    per_trial = preset.episodes + getattr(preset, "test_episodes", 0)  # the native calls count both
+    bar = tqdm(total=len(todo) * per_trial, unit="ep", disable=not progress, desc="episodes")
     meta.setdefault("trials", {})
     try:
         for name, first, n, result in execute(built, _chunks(todo, chunk), bar.update):

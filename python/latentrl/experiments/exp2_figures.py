@@ -1,0 +1,106 @@
+"""Figures of Experiment 2 (paper Fig. 5, 6a–d) from a run's arrays, PNG + PDF; needs matplotlib (the
+`[plot]` extra)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.patches import Rectangle
+from numpy.typing import NDArray
+
+from latentrl.datasets import arms_forward, grip_error
+from latentrl.experiments.exp2 import (
+    GRIP_TEST_TOLERANCE,
+    TARGET,
+    WALLS,
+    Exp2Preset,
+    Fitted,
+    fit,
+    in_walls,
+)
+from latentrl.experiments.presets import latent_box
+from latentrl.pca import PCA
+from latentrl.plots import (
+    hand_paths,
+    latent_value_panel,
+    learning_curves,
+    save_figure,
+)
+
+
+def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
+    """Fig. 5, 6a, 6b, 6c, 6d into `out` (PNG + PDF)."""
+    fitted = fit(preset)
+    _fig5(preset, fitted, out)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    window = max(1, min(preset.curve_window, preset.episodes // 5))
+    learning_curves(ax, {"latent": arrays["latent"]}, window=window)
+    ax.set_title("Exp 2: two planar arms, mean ± s.d. over trials")
+    save_figure(fig, out, "fig6a")
+    weights = arrays.get("latent_weights")
+    before = np.full(preset.rbf_per_dim**2, preset.initial_weight)
+    panels = (("fig6b", before, "before learning"), ("fig6d", weights, "after learning (trial 1)"))
+    for name, w, when in panels:
+        if w is None:
+            continue
+        fig, ax = plt.subplots(figsize=(6, 5))
+        _latent_panel(ax, fitted, np.asarray(w)[0] if w.ndim == 2 else w)
+        ax.set_title(f"value function {when}")
+        save_figure(fig, out, name)
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    _walls(ax)
+    tests = arrays.get("latent_test_paths")
+    paths = tests if tests is not None else arrays.get("latent_paths")
+    if paths is not None:
+        hand_paths(ax, paths[0], target=TARGET)
+    label = "frozen test episodes" if tests is not None else "recorded training episodes"
+    ax.set_title(f"hand paths, {label} (trial 1); dashed: right hand")
+    ax.set_xlim(-0.65, 0.6)
+    ax.set_ylim(-0.05, 0.65)
+    save_figure(fig, out, "fig6c")
+
+
+def _walls(ax: Axes) -> None:
+    for x0, y0, x1, y1 in WALLS:
+        ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, color="k"))
+
+
+def _latent_panel(ax: Axes, fitted: Fitted, weights: NDArray[np.float64], grid: int = 120) -> None:
+    """`plots.latent_value_panel` with the corridor mapped into latent space (black: decoded
+    hands in a wall), grip broken > 5 mm (red line) and the target region (dashed white)."""
+
+    def regions(ax: Axes, g0: NDArray[np.float64], g1: NDArray[np.float64], postures: NDArray[np.float64]) -> None:
+        hands = arms_forward(postures)
+        walls = in_walls(hands).reshape(g0.shape)
+        ax.contourf(g0, g1, walls.astype(float), levels=[0.5, 1.5], colors="k")
+        drop = grip_error(hands, test="vector").reshape(g0.shape)
+        ax.contour(g0, g1, drop, levels=[GRIP_TEST_TOLERANCE], colors="r", linewidths=1)
+        rms = np.sqrt(((hands - TARGET) ** 2).sum(axis=1) / 2).reshape(g0.shape)
+        ax.contour(g0, g1, rms, levels=[0.05], colors="w", linestyles="--", linewidths=1)
+
+    latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, regions=regions, grid=grid)
+
+
+def _fig5(preset: Exp2Preset, fitted: Fitted, out: Path) -> None:
+    """Uniform samples of each method's latent box (bounding box + `latent_margin`), decoded:
+    green keeps the constraint (| ‖h_R − h_L‖ − 0.1 | ≤ 5 mm), red breaks it."""
+    rng = np.random.default_rng(preset.seed)
+    pca = PCA(n_components=2).fit(fitted.demos)
+    methods = (("PCA", pca, pca.transform(fitted.demos)), ("GPLVM", fitted.model, fitted.model.Z_))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.5))
+    for ax, (name, model, latent) in zip(axes, methods):
+        low, high = latent_box(latent, preset.latent_margin)
+        samples = rng.uniform(low, high, size=(preset.fig5_samples, 2))
+        ok = grip_error(arms_forward(model.inverse_transform(samples))) <= GRIP_TEST_TOLERANCE
+        ax.plot(*samples[~ok].T, ".", color="tab:red", ms=3, label="constraint broken")
+        ax.plot(*samples[ok].T, ".", color="tab:green", ms=3, label="constraint kept")
+        ax.plot(*latent.T, "k.", ms=4, label="demonstrations")
+        ax.set_title(f"{name}: {100 * ok.mean():.1f} % of latent samples keep the grip")
+        ax.set_xlabel("z1")
+        ax.set_ylabel("z2")
+    axes[0].legend(loc="best", fontsize=8)
+    save_figure(fig, out, "fig5")

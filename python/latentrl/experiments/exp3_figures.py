@@ -1,0 +1,139 @@
+"""Figures of Experiment 3 (paper Fig. 7b–e, 8) from a run's arrays, PNG + PDF; needs matplotlib (the
+`[plot]` extra)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.patches import Rectangle
+from numpy.typing import NDArray
+
+from latentrl import humanoid
+from latentrl.experiments.exp1 import recorded_episodes
+from latentrl.experiments.exp3 import OBSTACLE, TASK_HEAD, Exp3Preset, Fitted, fit, rest_map, target
+from latentrl.plots import latent_value_panel, learning_curves, save_figure
+
+
+def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
+    """Fig. 7b, 7c, 7d, 7e and 8 into `out` (PNG + PDF)."""
+    fitted = fit(preset)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    window = max(1, min(preset.curve_window, preset.episodes // 5))
+    learning_curves(ax, {"latent": arrays["latent"]}, window=window)
+    ax.set_title("Exp 3: humanoid lift, mean ± s.d. over trials")
+    save_figure(fig, out, "fig7e")
+    weights = arrays.get("latent_weights")
+    before = np.full(preset.rbf_per_dim**2, preset.initial_weight)
+    panels = (("fig7b", before, "before learning"), ("fig7c", weights, "after learning (trial 1)"))
+    maps: dict[str, Any] = {}
+    for name, w, when in panels:
+        if w is None:
+            continue
+        fig, ax = plt.subplots(figsize=(6, 5))
+        _latent_panel(ax, preset, fitted, np.asarray(w)[0] if w.ndim == 2 else w, maps)
+        ax.set_title(f"value function {when}")
+        save_figure(fig, out, name)
+    tests = arrays.get("latent_test_paths")
+    paths = tests if tests is not None else arrays.get("latent_paths")
+    label = "frozen test episodes" if tests is not None else "recorded training episodes"
+    fig, ax = plt.subplots(figsize=(5, 5))
+    _side_view(ax)
+    if paths is not None:
+        for k, path in enumerate(paths[0]):
+            path = path[np.isfinite(path).all(axis=1)]
+            if path.size == 0:
+                continue
+            shade = plt.cm.viridis(k / max(len(paths[0]) - 1, 1))
+            ax.plot(path[:, 0], path[:, 2], color=shade, lw=1)
+            ax.plot(path[:, 3], path[:, 5], color=shade, lw=1, ls="--")
+            ax.plot(path[0, 0], path[0, 2], "o", color=shade, ms=3)
+    h_star = target()
+    ax.plot([h_star[0]], [h_star[2]], "r*", ms=10, label="target")
+    ax.set(xlim=(-0.05, 0.32), ylim=(-0.01, 0.36), xlabel="x (m, forward)", ylabel="z (m, up)")
+    ax.set_aspect("equal")
+    ax.set_title(f"hand paths, {label} (trial 1)\nside view; dashed: right hand")
+    save_figure(fig, out, "fig7d")
+    _fig8(arrays, tests if tests is not None else paths, "latent_test" if tests is not None else "latent", out)
+
+
+def _side_view(ax: Axes) -> None:
+    """The floor and the obstacle in the x–z plane."""
+    cx, _, cz, hx, _, hz = OBSTACLE
+    ax.add_patch(Rectangle((cx - hx, cz - hz), 2 * hx, 2 * hz, color="0.5", alpha=0.5))
+    ax.axhline(0.0, color="0.3", lw=1.5)
+
+
+def _latent_panel(
+    ax: Axes, preset: Exp3Preset, fitted: Fitted, weights: NDArray[np.float64], maps: dict[str, Any]
+) -> None:
+    """`plots.latent_value_panel` on a `map_grid` grid with the decoded postures at rest that touch
+    the obstacle (black), fall (grey) or break the grip (red), and the target region (dashed
+    white: RMS per-hand distance to h* ≤ 2 reach radii, standing). `maps` caches `rest_map`
+    between the panels."""
+    h_star = np.array(target())
+
+    def regions(ax: Axes, g0: NDArray[np.float64], g1: NDArray[np.float64], postures: NDArray[np.float64]) -> None:
+        if "rest" not in maps:
+            maps["rest"], maps["hands"] = rest_map(preset, postures)
+        rest, hands = maps["rest"].reshape(g0.shape), maps["hands"]
+        for code, colour in ((1, "k"), (4, "0.6"), (3, "tab:red")):
+            if (rest == code).any():
+                ax.contourf(g0, g1, (rest == code).astype(float), levels=[0.5, 1.5], colors=colour, alpha=0.8)
+        rms = np.sqrt(((hands - h_star) ** 2).sum(axis=1) / 2).reshape(g0.shape)
+        ax.contour(g0, g1, rms, levels=[2 * preset.reach_radius], colors="w", linestyles="--", linewidths=1)
+
+    latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, regions=regions, grid=preset.map_grid)
+    for i, (z0, z1) in enumerate(fitted.model.Z_):
+        ax.annotate(str(i), (z0, z1), color="w", fontsize=7, xytext=(3, 3), textcoords="offset points")
+
+
+def _base(row: NDArray[np.float64]) -> NDArray[np.float64]:
+    """4×4 base pose from a trajectory row (position at 6:9, quaternion x, y, z, w at 9:13)."""
+    x, y, z, w = row[9:13]
+    rotation = np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+    base = np.eye(4)
+    base[:3, :3] = rotation
+    base[:3, 3] = row[6:9]
+    return base
+
+
+def _fig8(arrays: Mapping[str, np.ndarray], paths: np.ndarray | None, returns_key: str, out: Path,
+          frames: int = 6) -> None:
+    """Frames of the best recorded episode of trial 1 (highest return), side view, drawn from the
+    recorded base poses and joint angles with the NumPy kinematics (`Humanoid.link_poses`)."""
+    fig, ax = plt.subplots(figsize=(10, 3))
+    if paths is not None and paths.shape[1] > 0:
+        returns = np.asarray(arrays[returns_key])[0]
+        recorded = np.arange(paths.shape[1])
+        if returns_key == "latent":
+            # Training paths are recorded for `recorded_episodes`; rank them by their own return.
+            recorded = np.array(recorded_episodes(returns.shape[0]))[: paths.shape[1]]
+        best = int(np.nanargmax(returns[recorded]))
+        path = paths[0, best]
+        path = path[np.isfinite(path).all(axis=1)]
+        h = humanoid.model()
+        picks = np.unique(np.linspace(0, len(path) - 1, frames).round().astype(int))
+        for k, step in enumerate(picks):
+            dx = 0.35 * k
+            poses = h.link_poses(path[step, TASK_HEAD:], _base(path[step]))
+            cx, _, cz, hx, _, hz = OBSTACLE
+            ax.add_patch(Rectangle((dx + cx - hx, cz - hz), 2 * hx, 2 * hz, color="0.5", alpha=0.4))
+            for parent, child in h.edges:
+                a, b = poses[parent][:3, 3], poses[child][:3, 3]
+                ax.plot([dx + a[0], dx + b[0]], [a[2], b[2]], "o-", color="C0", lw=2, ms=2)
+            ax.text(dx + 0.05, 0.33, f"step {step}", fontsize=8, ha="center")
+        ax.set_title(f"a learnt lift: recorded episode {int(recorded[best])} of trial 1 "
+                     f"(return {returns[recorded[best]]:.1f})")
+    ax.axhline(0.0, color="0.3", lw=1.5)
+    ax.set_aspect("equal")
+    ax.set(xlabel="x (m; frames 0.35 m apart)", ylabel="z (m)", ylim=(-0.01, 0.36))
+    save_figure(fig, out, "fig8")
