@@ -90,6 +90,8 @@ def test_bad_inputs_raise_clear_errors(sim):
         Sim(arms_urdf(), root="loose")  # type: ignore[arg-type]
     with pytest.raises(InvalidInputError, match="substeps"):
         Sim(arms_urdf(), substeps=0)
+    with pytest.raises(InvalidInputError, match="pgs_iterations: expected an int > 0, got 0"):
+        Sim(arms_urdf(), pgs_iterations=0)
     with pytest.raises(InvalidInputError, match="dt"):
         Sim(arms_urdf(), dt=-1.0)
     with pytest.raises(InvalidInputError, match="kp|<any>"):

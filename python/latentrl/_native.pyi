@@ -81,6 +81,7 @@ class Sim:
         dt: float = ...,
         substeps: int = 12,
         solver_iterations: int = 4,
+        pgs_iterations: int = 1,
         kp: float = 5000.0,
         kd: float = 50.0,
         max_force: float = ...,
@@ -166,6 +167,7 @@ def humanoid_fall_check(
     max_force: float,
     dt: float,
     solver_iterations: int,
+    pgs_iterations: int,
     grip_width: float,
 ) -> NDArray[np.float64]:
     """Fall check of the floating humanoid (SPEC §4.3): stand at `start` (D,), hold each row

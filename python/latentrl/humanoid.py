@@ -37,16 +37,21 @@ class ServoGains(TypedDict):
 
 
 class PhysicsSettings(TypedDict):
-    """Physics step (s) and solver iterations: keyword arguments of `Sim` and the fall check."""
+    """Physics step (s), solver iterations and PGS passes per iteration: keyword arguments of
+    `Sim` and the fall check."""
 
     dt: float
     solver_iterations: int
+    pgs_iterations: int
 
 
 #: Servo of the humanoid (SPEC §4.3's MuJoCo study): kp N·m/rad, kd N·m·s/rad, cap N·m.
 SERVO: ServoGains = {"kp": 8.0, "kd": 0.1, "max_force": 1.2}
-#: Physics step (s) and solver iterations of the fall check (10 s stand test passes).
-PHYSICS: PhysicsSettings = {"dt": 1.0 / 240.0, "solver_iterations": 4}
+#: Physics of the humanoid: dt 1/240 s, 1 rapier solver iteration of 4 PGS passes. Each solver
+#: iteration refreshes the multibody's mass matrix (most of a step's cost), PGS passes do not:
+#: this stands 10 s (an Exp 3 episode at most) drifting 0.9 mm (4 iterations of 1 pass: 2.3 mm)
+#: at 0.3 × the cost; over 60 s it creeps 59 mm (4 × 1: 14 mm; benches/README.md).
+PHYSICS: PhysicsSettings = {"dt": 1.0 / 240.0, "solver_iterations": 1, "pgs_iterations": 4}
 
 
 def urdf_path() -> Path:

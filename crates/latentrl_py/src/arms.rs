@@ -12,7 +12,7 @@ use crate::rl::{RunArgs, apply_config_dict, echo_learner, float, floats, invalid
 use crate::simconfig::{echo_sim, run_latent_2d, set_sim_key, string, urdf_model};
 
 /// The plant keys of Experiment 2's config dict, in the order they are documented and echoed.
-const ARMS_KEYS: [&str; 16] = [
+const ARMS_KEYS: [&str; 17] = [
     "target",
     "theta",
     "length_scale",
@@ -27,6 +27,7 @@ const ARMS_KEYS: [&str; 16] = [
     "dt",
     "substeps",
     "solver_iterations",
+    "pgs_iterations",
     "kp",
     "kd",
 ];

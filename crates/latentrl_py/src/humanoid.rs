@@ -15,12 +15,13 @@ const COLUMNS: usize = 6;
 /// Runs the fall check of `sim::humanoid::run_fall_check` on the URDF at `urdf_path`
 /// (floating root, ground at z = 0): stand at `start` `(D,)`, hold each row of `targets`
 /// `(M, D)` for `hold` s under PD servos (`kp` N·m/rad, `kd` N·m·s/rad, torque capped at
-/// `max_force` and at the URDF effort), physics step `dt`, `solver_iterations`.
+/// `max_force` and at the URDF effort), physics step `dt`, `solver_iterations`,
+/// `pgs_iterations`.
 /// Returns `(M, 6)`: fell (0/1), smallest support margin (m), final support margin (m),
 /// grip error at the end (hand distance − `grip_width`, m), largest |grip error| (m),
 /// base height at the end (m).
 #[pyfunction]
-#[pyo3(signature = (urdf_path, start, targets, *, hold, kp, kd, max_force, dt, solver_iterations, grip_width))]
+#[pyo3(signature = (urdf_path, start, targets, *, hold, kp, kd, max_force, dt, solver_iterations, pgs_iterations, grip_width))]
 #[allow(clippy::too_many_arguments)]
 pub fn humanoid_fall_check<'py>(
     py: Python<'py>,
@@ -33,6 +34,7 @@ pub fn humanoid_fall_check<'py>(
     max_force: f64,
     dt: f64,
     solver_iterations: usize,
+    pgs_iterations: usize,
     grip_width: f64,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     guard(|| {
@@ -54,6 +56,7 @@ pub fn humanoid_fall_check<'py>(
             gains,
             dt,
             solver_iterations,
+            pgs_iterations,
             ..SimOptions::default()
         };
         let config = FallCheckConfig {

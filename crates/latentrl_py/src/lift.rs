@@ -13,7 +13,7 @@ use crate::rl::{RunArgs, apply_config_dict, echo_learner, float, floats, invalid
 use crate::simconfig::{echo_sim, run_latent_2d, set_sim_key, string, urdf_model};
 
 /// The plant keys of Experiment 3's config dict, in the order they are documented and echoed.
-const LIFT_KEYS: [&str; 21] = [
+const LIFT_KEYS: [&str; 22] = [
     "target",
     "theta",
     "length_scale",
@@ -32,6 +32,7 @@ const LIFT_KEYS: [&str; 21] = [
     "dt",
     "substeps",
     "solver_iterations",
+    "pgs_iterations",
     "kp",
     "kd",
     "max_force",
@@ -172,7 +173,8 @@ fn echo_config<'py>(py: Python<'py>, plant: &LiftConfig, learner: &LearnerConfig
 ///     base_height_fraction (0.5), obstacles ([[0.215, 0, 0.175, 0.05, 0.12, 0.125]]: axis-
 ///     aligned sensor boxes [cx, cy, cz, hx, hy, hz]), start_posture (None = home; the
 ///     plant's own start, used with start="plant"), start_noise (0.01 rad), min_start_margin
-///     (0 m), dt (1/240), substeps (12), solver_iterations (4), kp (8), kd (0.1), max_force
+///     (0 m), dt (1/240), substeps (12), solver_iterations (1), pgs_iterations (4), kp (8),
+///     kd (0.1), max_force
 ///     (1.2 N·m); learner: alpha (0.8), gamma (0.99), initial_weight (0), beta (20),
 ///     step_fraction (0.2), max_steps (200), centres_per_dim (20), rbf_width (1),
 ///     rbf_cutoff (3), variance_threshold (None), start ("uniform" | "plant"),

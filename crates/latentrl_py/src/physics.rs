@@ -30,7 +30,7 @@ impl PySim {
     #[new]
     #[pyo3(signature = (
         urdf, *, root = "fixed", dt = 1.0 / 240.0, substeps = 12, solver_iterations = 4,
-        kp = 5000.0, kd = 50.0, max_force = f64::INFINITY, gravity = None, ground = None
+        pgs_iterations = 1, kp = 5000.0, kd = 50.0, max_force = f64::INFINITY, gravity = None, ground = None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -40,6 +40,7 @@ impl PySim {
         dt: f64,
         substeps: i64,
         solver_iterations: i64,
+        pgs_iterations: i64,
         kp: f64,
         kd: f64,
         max_force: f64,
@@ -67,6 +68,7 @@ impl PySim {
                 dt,
                 substeps: count("substeps", substeps)?,
                 solver_iterations: count("solver_iterations", solver_iterations)?,
+                pgs_iterations: count("pgs_iterations", pgs_iterations)?,
                 gains: PdGains::new(kp, kd, max_force).map_err(sim_to_py)?,
                 ground,
                 ..SimOptions::default()

@@ -20,13 +20,14 @@ pub(crate) fn string(name: &str, value: &Bound<'_, PyAny>) -> PyResult<String> {
         .map_err(|_| invalid(format!("config[{name:?}]: expected a str, got {}", type_name(value))))
 }
 
-/// Sets physics key `key` (dt, substeps, solver_iterations, kp, kd); `Ok(false)` if it is
+/// Sets physics key `key` (dt, substeps, solver_iterations, pgs_iterations, kp, kd); `Ok(false)` if it is
 /// none of them.
 pub(crate) fn set_sim_key(sim: &mut SimOptions, key: &str, v: &Bound<'_, PyAny>) -> PyResult<bool> {
     match key {
         "dt" => sim.dt = float(key, v)?,
         "substeps" => sim.substeps = int_in("config[\"substeps\"]", v, 1, 1_000_000)? as usize,
         "solver_iterations" => sim.solver_iterations = int_in("config[\"solver_iterations\"]", v, 1, 1000)? as usize,
+        "pgs_iterations" => sim.pgs_iterations = int_in("config[\"pgs_iterations\"]", v, 1, 1000)? as usize,
         "kp" => sim.gains.kp = float(key, v)?,
         "kd" => sim.gains.kd = float(key, v)?,
         _ => return Ok(false),
@@ -39,6 +40,7 @@ pub(crate) fn echo_sim(d: &Bound<'_, PyDict>, sim: &SimOptions) -> PyResult<()> 
     d.set_item("dt", sim.dt)?;
     d.set_item("substeps", sim.substeps)?;
     d.set_item("solver_iterations", sim.solver_iterations)?;
+    d.set_item("pgs_iterations", sim.pgs_iterations)?;
     d.set_item("kp", sim.gains.kp)?;
     d.set_item("kd", sim.gains.kd)
 }

@@ -1,7 +1,8 @@
 //! The KHR-1HV-like humanoid on rapier3d 0.36.1: physics steps/s of the free-floating robot
 //! standing on the ground under servo PD (SPEC §4.3; kp 8 N·m/rad, kd 0.1 N·m·s/rad, ±1.2 N·m,
-//! dt 1/240), at its home posture and at the first lift demo, at 4 solver iterations (the fall
-//! check) and 1 (it also stands, docs/humanoid.md).
+//! dt 1/240), at its home posture and at the first lift demo, with the humanoid's physics
+//! (1 solver iteration of 4 PGS passes, `latentrl.humanoid.PHYSICS`) and rapier's default
+//! (4 iterations of 1 pass).
 //!
 //! Peer: MuJoCo on the same URDF, measured side by side in `benches/bench_sim.py`.
 //! Run: `cargo bench -p sim --bench humanoid_step`.
@@ -22,7 +23,7 @@ const STEPS: usize = 10;
 /// standing 10 s, so every timed step is of a standing robot.
 const RESTART_AFTER: f64 = 10.0;
 
-fn humanoid(solver_iterations: usize) -> PhysicsSim {
+fn humanoid((solver_iterations, pgs_iterations): (usize, usize)) -> PhysicsSim {
     let options = SimOptions {
         root: RootMode::Floating,
         ground: Some(0.0),
@@ -32,6 +33,7 @@ fn humanoid(solver_iterations: usize) -> PhysicsSim {
             max_force: 1.2,
         },
         solver_iterations,
+        pgs_iterations,
         ..SimOptions::default()
     };
     PhysicsSim::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
@@ -50,9 +52,9 @@ fn physics_steps(c: &mut Criterion) {
     let home = vec![0.0; 19];
     let demo = lift_demo();
     let settings = [
-        ("home_it4", &home, 4),
-        ("home_it1", &home, 1),
-        ("lift_demo0_it4", &demo, 4),
+        ("home_it1_pgs4", &home, (1, 4)),
+        ("home_it4", &home, (4, 1)),
+        ("lift_demo0_it1_pgs4", &demo, (1, 4)),
     ];
     for (label, posture, iterations) in settings {
         let mut sim = humanoid(iterations);

@@ -95,7 +95,7 @@ pub struct LiftConfig {
     /// support polygon) is at least this (m). Default 0.
     pub min_start_margin: f64,
     /// The physics world. Default: floating root, floor at z = 0, dt 1/240 s × 12 sub-steps,
-    /// 4 solver iterations, servos kp 8 N·m/rad, kd 0.1 N·m·s/rad, capped at 1.2 N·m
+    /// 1 solver iteration of 4 PGS passes, servos kp 8 N·m/rad, kd 0.1 N·m·s/rad, capped at 1.2 N·m
     /// (`latentrl.humanoid.SERVO`, `PHYSICS`).
     pub sim: SimOptions,
 }
@@ -131,6 +131,8 @@ impl Default for LiftConfig {
                     kd: 0.1,
                     max_force: 1.2,
                 },
+                solver_iterations: 1,
+                pgs_iterations: 4,
                 ..SimOptions::default()
             },
         }

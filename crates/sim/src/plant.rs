@@ -49,6 +49,7 @@ impl PhysicsSim {
         world.gravity = Vector::new(gx as Real, gy as Real, gz as Real);
         world.integration_parameters.dt = options.dt as Real;
         world.integration_parameters.num_solver_iterations = options.solver_iterations;
+        world.integration_parameters.num_internal_pgs_iterations = options.pgs_iterations;
         let robot = model.insert(&mut world, options.root, options.self_collisions)?;
         let ground = options.ground.map(|z| {
             let plane =

@@ -16,8 +16,14 @@ pub struct SimOptions {
     pub dt: f64,
     /// Physics steps per RL step. Default 12, i.e. an RL step of 0.05 s (paper's δt).
     pub substeps: usize,
-    /// rapier solver iterations per physics step. Default 4 (rapier's default).
+    /// rapier solver iterations per physics step. Default 4 (rapier's default). Each is a
+    /// small step that also refreshes every multibody's kinematics and mass matrix, which
+    /// dominates the humanoid's cost.
     pub solver_iterations: usize,
+    /// Projected Gauss-Seidel passes over the constraints inside each solver iteration.
+    /// Default 1 (rapier's default); more tightens contacts and limits without the mass
+    /// matrix refresh of more `solver_iterations`.
+    pub pgs_iterations: usize,
     /// Height of a ground half-space (normal +z), or `None` for no ground. Default `None`.
     pub ground: Option<f64>,
     /// Servo gains of every joint at start (change per joint with `set_gains`).
@@ -43,6 +49,7 @@ impl Default for SimOptions {
             dt: 1.0 / 240.0,
             substeps: 12,
             solver_iterations: 4,
+            pgs_iterations: 1,
             ground: None,
             gains: PdGains::default(),
             use_urdf_effort: true,
@@ -61,6 +68,7 @@ impl SimOptions {
             ("dt", self.dt),
             ("substeps", self.substeps as f64),
             ("solver_iterations", self.solver_iterations as f64),
+            ("pgs_iterations", self.pgs_iterations as f64),
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
