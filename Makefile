@@ -34,7 +34,12 @@ test: lint ## clippy, stub check, Rust tests (pure crates and the binding's pani
 	$(PY) -m pytest -q
 	$(MAKE) --no-print-directory install-check
 
-test-all: lint ## everything, slow reproductions included
+# The [sb3] extra's package, installed by name: `pip install -e ".[sb3]"` would rebuild the native module.
+$(VENV)/.sb3: $(VENV)/.deps
+	$(PY) -m pip install --quiet "stable-baselines3>=2.3"
+	touch $@
+
+test-all: lint $(VENV)/.sb3 ## everything, slow reproductions and the SB3 example included (installs the [sb3] extra, ≈ 3 GB)
 	cargo test --quiet
 	cargo test --quiet -p latentrl_py --lib
 	$(PY) -m pytest -q -m ''

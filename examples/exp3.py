@@ -1,5 +1,5 @@
 """Experiment 3 (paper Fig. 7b–e, 8) on the paper's scale: the simulated humanoid lifts an object,
-5 trials × 6000 episodes × ≤ 200 steps (≈ 6 M physics-simulated RL steps: hours, docs/exp3.md).
+4 trials × 6000 episodes × ≤ 200 steps (≤ 4.8 M physics-simulated RL steps: ≈ 1 h on 2 cores, docs/exp3.md).
 
     python examples/exp3.py [--quick] [--out results/exp3]
 """

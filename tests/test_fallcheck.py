@@ -95,3 +95,18 @@ def test_pca_misses_the_demos_by_degrees(table):
     assert max(abs(r["grip_error"]) for r in pca) > 5e-3
     assert np.isfinite([r["sim_margin"] for r in pca]).all()  # falls: reported, not asserted
     assert GRIP_WIDTH == 0.10
+
+
+def test_fig7a_frames_agree_with_the_table(tmp_path):
+    pytest.importorskip("matplotlib")
+    from latentrl.experiments.fallcheck_figures import fallcheck_frames
+
+    seen = fallcheck_frames(tmp_path, ("pose", 6))
+    for ext in ("png", "pdf"):
+        assert (tmp_path / f"fig7a.{ext}").stat().st_size > 10_000
+    rows = {r["method"]: r for r in run_fallcheck() if r["segment"] == "pose 6"}
+    for method in ("PCA", "GPLVM"):
+        assert seen[method]["fell"] == rows[method]["fell"]
+        assert abs(seen[method]["min_margin"] - rows[method]["sim_margin"]) < 1e-4
+    assert seen["PCA"]["fell"] and seen["PCA"]["fall_time"] is not None
+    assert not seen["GPLVM"]["fell"] and seen["GPLVM"]["base_height"] > 0.1

@@ -231,7 +231,7 @@ class Humanoid:
         low = min(c[2] for c in corners)
         pts = np.array([c[:2] for c in corners if c[2] <= low + 2e-3])
         com = self.com(poses)[:2]
-        margin = _hull_margin(com, pts)
+        margin = hull_margin(com, pts)
         hands = np.linalg.norm(poses["l_hand"][:3, 3] - poses["r_hand"][:3, 3])
         torso = poses[self.root][:3, :3]
         return {
@@ -247,7 +247,7 @@ def _cross(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
     return float(a[0] * b[1] - a[1] * b[0])
 
 
-def _hull_margin(p: NDArray[np.float64], pts: NDArray[np.float64]) -> float:
+def hull_margin(p: NDArray[np.float64], pts: NDArray[np.float64]) -> float:
     """Signed distance from `p` to the convex hull of `pts` (positive inside)."""
     pts = np.unique(np.round(pts, 12), axis=0)
     pts = pts[np.lexsort((pts[:, 1], pts[:, 0]))]

@@ -109,6 +109,44 @@ def latent_value_panel(
     ax.set_ylabel("z2")
 
 
+def latent_run_figures(
+    preset: Any,
+    arrays: Mapping[str, np.ndarray],
+    out_dir: Path,
+    *,
+    names: tuple[str, str, str],
+    title: str,
+    panel: Callable[[Axes, NDArray[np.float64]], None],
+) -> None:
+    """A latent learner's return curve (`names[0]`: mean ± s.d. over trials, running mean of
+    min(`curve_window`, episodes // 5)) and its value function before (`names[1]`: the
+    initial weight everywhere) and after learning (`names[2]`: trial 1), each drawn by
+    `panel(ax, weights)`; the latter only if the run kept its weights."""
+    fig, ax = plt.subplots(figsize=(6, 4))
+    window = max(1, min(preset.curve_window, preset.episodes // 5))
+    learning_curves(ax, {"latent": arrays["latent"]}, window=window)
+    ax.set_title(title)
+    save_figure(fig, out_dir, names[0])
+    weights = arrays.get("latent_weights")
+    before = np.full(preset.rbf_per_dim**2, preset.initial_weight)
+    for name, w, when in ((names[1], before, "before learning"), (names[2], weights, "after learning (trial 1)")):
+        if w is None:
+            continue
+        fig, ax = plt.subplots(figsize=(6, 5))
+        panel(ax, np.asarray(w)[0] if w.ndim == 2 else np.asarray(w))
+        ax.set_title(f"value function {when}")
+        save_figure(fig, out_dir, name)
+
+
+def shown_paths(arrays: Mapping[str, np.ndarray]) -> tuple[np.ndarray | None, str, str]:
+    """The recorded paths to draw: the frozen test episodes' if any, else the recorded training
+    episodes'; what they are; and the key of their returns."""
+    tests = arrays.get("latent_test_paths")
+    if tests is not None:
+        return tests, "frozen test episodes", "latent_test"
+    return arrays.get("latent_paths"), "recorded training episodes", "latent"
+
+
 def save_figure(fig: Figure, out_dir: Path, name: str) -> list[Path]:
     """Writes `name.png` and `name.pdf` into `out_dir` atomically and closes the figure."""
     written = []

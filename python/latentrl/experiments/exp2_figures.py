@@ -26,9 +26,10 @@ from latentrl.experiments.presets import latent_box
 from latentrl.pca import PCA
 from latentrl.plots import (
     hand_paths,
+    latent_run_figures,
     latent_value_panel,
-    learning_curves,
     save_figure,
+    shown_paths,
 )
 
 
@@ -36,28 +37,15 @@ def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], out: Path) -> 
     """Fig. 5, 6a, 6b, 6c, 6d into `out` (PNG + PDF)."""
     fitted = fit(preset)
     _fig5(preset, fitted, out)
-    fig, ax = plt.subplots(figsize=(6, 4))
-    window = max(1, min(preset.curve_window, preset.episodes // 5))
-    learning_curves(ax, {"latent": arrays["latent"]}, window=window)
-    ax.set_title("Exp 2: two planar arms, mean ± s.d. over trials")
-    save_figure(fig, out, "fig6a")
-    weights = arrays.get("latent_weights")
-    before = np.full(preset.rbf_per_dim**2, preset.initial_weight)
-    panels = (("fig6b", before, "before learning"), ("fig6d", weights, "after learning (trial 1)"))
-    for name, w, when in panels:
-        if w is None:
-            continue
-        fig, ax = plt.subplots(figsize=(6, 5))
-        _latent_panel(ax, fitted, np.asarray(w)[0] if w.ndim == 2 else w)
-        ax.set_title(f"value function {when}")
-        save_figure(fig, out, name)
+    latent_run_figures(
+        preset, arrays, out, names=("fig6a", "fig6b", "fig6d"), title="Exp 2: two planar arms, mean ± s.d. over trials",
+        panel=lambda ax, w: _latent_panel(ax, fitted, w),
+    )
     fig, ax = plt.subplots(figsize=(6, 4.5))
     _walls(ax)
-    tests = arrays.get("latent_test_paths")
-    paths = tests if tests is not None else arrays.get("latent_paths")
+    paths, label, _ = shown_paths(arrays)
     if paths is not None:
         hand_paths(ax, paths[0], target=TARGET)
-    label = "frozen test episodes" if tests is not None else "recorded training episodes"
     ax.set_title(f"hand paths, {label} (trial 1); dashed: right hand")
     ax.set_xlim(-0.65, 0.6)
     ax.set_ylim(-0.05, 0.65)

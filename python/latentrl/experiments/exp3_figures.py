@@ -16,31 +16,18 @@ from numpy.typing import NDArray
 from latentrl import humanoid
 from latentrl.experiments.exp1 import recorded_episodes
 from latentrl.experiments.exp3 import OBSTACLE, TASK_HEAD, Exp3Preset, Fitted, fit, rest_map, target
-from latentrl.plots import latent_value_panel, learning_curves, save_figure
+from latentrl.plots import latent_run_figures, latent_value_panel, save_figure, shown_paths
 
 
 def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
     """Fig. 7b, 7c, 7d, 7e and 8 into `out` (PNG + PDF)."""
     fitted = fit(preset)
-    fig, ax = plt.subplots(figsize=(6, 4))
-    window = max(1, min(preset.curve_window, preset.episodes // 5))
-    learning_curves(ax, {"latent": arrays["latent"]}, window=window)
-    ax.set_title("Exp 3: humanoid lift, mean ± s.d. over trials")
-    save_figure(fig, out, "fig7e")
-    weights = arrays.get("latent_weights")
-    before = np.full(preset.rbf_per_dim**2, preset.initial_weight)
-    panels = (("fig7b", before, "before learning"), ("fig7c", weights, "after learning (trial 1)"))
     maps: dict[str, Any] = {}
-    for name, w, when in panels:
-        if w is None:
-            continue
-        fig, ax = plt.subplots(figsize=(6, 5))
-        _latent_panel(ax, preset, fitted, np.asarray(w)[0] if w.ndim == 2 else w, maps)
-        ax.set_title(f"value function {when}")
-        save_figure(fig, out, name)
-    tests = arrays.get("latent_test_paths")
-    paths = tests if tests is not None else arrays.get("latent_paths")
-    label = "frozen test episodes" if tests is not None else "recorded training episodes"
+    latent_run_figures(
+        preset, arrays, out, names=("fig7e", "fig7b", "fig7c"), title="Exp 3: humanoid lift, mean ± s.d. over trials",
+        panel=lambda ax, w: _latent_panel(ax, preset, fitted, w, maps),
+    )
+    paths, label, returns_key = shown_paths(arrays)
     fig, ax = plt.subplots(figsize=(5, 5))
     _side_view(ax)
     if paths is not None:
@@ -58,7 +45,7 @@ def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], out: Path) -> 
     ax.set_aspect("equal")
     ax.set_title(f"hand paths, {label} (trial 1)\nside view; dashed: right hand")
     save_figure(fig, out, "fig7d")
-    _fig8(arrays, tests if tests is not None else paths, "latent_test" if tests is not None else "latent", out)
+    _fig8(arrays, paths, returns_key, out)
 
 
 def _side_view(ax: Axes) -> None:

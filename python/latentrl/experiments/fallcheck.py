@@ -18,7 +18,7 @@ effect depends on how close to the heel the demos balance (docs/humanoid.md).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -59,8 +59,13 @@ def _rms_max(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[float, flo
     return float(np.sqrt(np.mean(d**2))), float(np.abs(d).max())
 
 
-def run_fallcheck(preset: FallCheckPreset | None = None) -> list[dict[str, Any]]:
-    """Runs the check; one dict per (method, pose or line) with the keys of `COLUMNS`."""
+#: Per method: the latent point of every demo (N, d) and its decoder (clipped to the joint limits).
+Coders = dict[str, tuple[NDArray[np.float64], Callable[[NDArray[np.float64]], NDArray[np.float64]]]]
+
+
+def fit_coders(preset: FallCheckPreset | None = None) -> tuple[NDArray[np.float64], Coders]:
+    """The demo postures X (N, D) and, per method of `METHODS`, the demos' latent points and a
+    decoder of latent points (M, d) to postures (M, D) clipped to the joint limits."""
     p = preset or FallCheckPreset()
     h = model()
     demos = load_demos(
@@ -71,31 +76,58 @@ def run_fallcheck(preset: FallCheckPreset | None = None) -> list[dict[str, Any]]
         raise ValueError(f"styles: {len(p.styles)} labels for {len(X)} demos")
     pca = PCA(n_components=2).fit(X)
     gplvm = GPLVM(n_components=2, random_state=p.random_state).fit(X)
-    coders: dict[str, tuple[Any, Any]] = {
+    raw: dict[str, tuple[NDArray[np.float64], Any]] = {
         "PCA": (pca.transform(X), pca.inverse_transform),
         "GPLVM": (gplvm.Z_, gplvm.inverse_transform),
         "joint": (X, lambda z: np.asarray(z, dtype=float)),
     }
 
-    def decode(method: str, z: NDArray[np.float64]) -> NDArray[np.float64]:
-        decoded: NDArray[np.float64] = np.clip(coders[method][1](np.atleast_2d(z)), h.lower, h.upper)
-        return decoded
+    def clipped(f: Any) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
+        def decode(z: NDArray[np.float64]) -> NDArray[np.float64]:
+            out: NDArray[np.float64] = np.clip(f(np.atleast_2d(z)), h.lower, h.upper)
+            return out
 
+        return decode
+
+    return X, {m: (latent, clipped(f)) for m, (latent, f) in raw.items()}
+
+
+def segments(preset: FallCheckPreset | None = None) -> list[str]:
+    """Names of the checked segments: "pose i" per demo, then "line i-j" per pair of
+    consecutive demos of one style."""
+    styles = (preset or FallCheckPreset()).styles
+    lines = [f"line {i}-{i + 1}" for i in range(len(styles) - 1) if styles[i] == styles[i + 1]]
+    return [f"pose {i}" for i in range(len(styles))] + lines
+
+
+def segment_targets(
+    X: NDArray[np.float64], coder: tuple[NDArray[np.float64], Any], segment: str,
+    preset: FallCheckPreset | None = None,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], float]:
+    """Servo targets (M, D) of `segment` (a name of `segments`) decoded by `coder` (an entry of
+    `fit_coders`), the joint-space reference (M, D) and the hold per target (s); the check
+    starts standing at the first target."""
+    p = preset or FallCheckPreset()
+    latent, decode = coder
+    kind, index = segment.split()
+    if kind == "pose":
+        i = int(index)
+        return decode(latent[i]), X[i][None], p.pose_hold
+    i, j = (int(k) for k in index.split("-"))
+    s = np.linspace(0.0, 1.0, p.path_points)[:, None]
+    return decode((1 - s) * latent[i] + s * latent[j]), (1 - s) * X[i] + s * X[j], p.path_hold
+
+
+def run_fallcheck(preset: FallCheckPreset | None = None) -> list[dict[str, Any]]:
+    """Runs the check; one dict per (method, pose or line) with the keys of `COLUMNS`."""
+    p = preset or FallCheckPreset()
+    X, coders = fit_coders(p)
     rows: list[dict[str, Any]] = []
     for method in METHODS:
-        latent = coders[method][0]
-        for i in range(len(X)):
-            pose = decode(method, latent[i])[0]
-            sim = fall_check(pose, pose[None], hold=p.pose_hold)[0]
-            rows.append(_row(method, f"pose {i}", pose[None], X[i][None], sim[None], h))
-        for i in range(len(X) - 1):
-            if p.styles[i] != p.styles[i + 1]:
-                continue
-            s = np.linspace(0.0, 1.0, p.path_points)[:, None]
-            targets = decode(method, (1 - s) * latent[i] + s * latent[i + 1])
-            control = (1 - s) * X[i] + s * X[i + 1]
-            sim = fall_check(targets[0], targets, hold=p.path_hold)
-            rows.append(_row(method, f"line {i}-{i + 1}", targets, control, sim, h))
+        for segment in segments(p):
+            targets, control, hold = segment_targets(X, coders[method], segment, p)
+            sim = fall_check(targets[0], targets, hold=hold)
+            rows.append(_row(method, segment, targets, control, sim, model()))
     return rows
 
 
