@@ -64,7 +64,10 @@ def _to_plain(value: Any) -> Any:
 
 
 def environment() -> dict[str, Any]:
-    """Package and dependency versions, git revision if known, Python, platform, threads."""
+    """Package and dependency versions, git revision if known, Python, platform, CPU model,
+    threads. The CPU matters for reproducing numbers: the same seed gives the same results on
+    one machine, but the physics' f32 maths (glibc picks CPU-specific sin/cos/exp) may differ
+    in the last bits on another CPU, and RL runs amplify that."""
     versions: dict[str, str | None] = {}
     for name in ("latentrl", "numpy", "scipy", "matplotlib"):
         try:
@@ -76,10 +79,22 @@ def environment() -> dict[str, Any]:
         "versions": versions,
         "python": platform.python_version(),
         "platform": platform.platform(),
+        "cpu": _cpu_model(),
         "git_revision": _git_revision(),
         "cpu_count": os.cpu_count(),
         "rayon_threads": worker_threads(),
     }
+
+
+def _cpu_model() -> str:
+    """The CPU's model name (Linux: /proc/cpuinfo), else `platform.processor()`."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor()
 
 
 def worker_threads() -> int:
