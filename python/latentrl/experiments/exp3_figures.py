@@ -95,20 +95,28 @@ def _base(row: NDArray[np.float64]) -> NDArray[np.float64]:
 
 def _fig8(arrays: Mapping[str, np.ndarray], paths: np.ndarray | None, returns_key: str, out: Path,
           frames: int = 6) -> None:
-    """Frames of the best recorded episode of trial 1 (highest return), side view, drawn from the
-    recorded base poses and joint angles with the NumPy kinematics (`Humanoid.link_poses`)."""
+    """Frames of a learnt lift: of trial 1's recorded episodes that reached h* (all, if none
+    did), the one whose hands rose most; frames from its start to where the hands are 95 % of
+    the way up, and its last step. Side view, drawn from the recorded base poses and joint
+    angles with the NumPy kinematics (`Humanoid.link_poses`)."""
     fig, ax = plt.subplots(figsize=(10, 3))
     if paths is not None and paths.shape[1] > 0:
         returns = np.asarray(arrays[returns_key])[0]
+        reached = np.asarray(arrays[returns_key + "_reached"])[0]
         recorded = np.arange(paths.shape[1])
         if returns_key == "latent":
-            # Training paths are recorded for `recorded_episodes`; rank them by their own return.
+            # Training paths are recorded for `recorded_episodes`.
             recorded = np.array(recorded_episodes(returns.shape[0]))[: paths.shape[1]]
-        best = int(np.nanargmax(returns[recorded]))
+        heights = [_hand_height(paths[0, k]) for k in range(len(recorded))]
+        rise = np.array([z.max() - z[0] for z in heights])
+        candidates = np.flatnonzero(reached[recorded]) if reached[recorded].any() else np.arange(len(recorded))
+        best = int(candidates[np.argmax(rise[candidates])])
         path = paths[0, best]
         path = path[np.isfinite(path).all(axis=1)]
+        z = heights[best]
+        top = int(np.argmax(z >= z[0] + 0.95 * rise[best]))
+        picks = np.unique(np.r_[np.linspace(0, top, frames - 1).round().astype(int), len(path) - 1])
         h = humanoid.model()
-        picks = np.unique(np.linspace(0, len(path) - 1, frames).round().astype(int))
         for k, step in enumerate(picks):
             dx = 0.35 * k
             poses = h.link_poses(path[step, TASK_HEAD:], _base(path[step]))
@@ -118,9 +126,15 @@ def _fig8(arrays: Mapping[str, np.ndarray], paths: np.ndarray | None, returns_ke
                 a, b = poses[parent][:3, 3], poses[child][:3, 3]
                 ax.plot([dx + a[0], dx + b[0]], [a[2], b[2]], "o-", color="C0", lw=2, ms=2)
             ax.text(dx + 0.05, 0.33, f"step {step}", fontsize=8, ha="center")
-        ax.set_title(f"a learnt lift: recorded episode {int(recorded[best])} of trial 1 "
-                     f"(return {returns[recorded[best]]:.1f})")
+        ax.set_title(f"a learnt lift: recorded episode {int(recorded[best])} of trial 1 (return "
+                     f"{returns[recorded[best]]:.1f}, hands {1e3 * rise[best]:.0f} mm up)")
     ax.axhline(0.0, color="0.3", lw=1.5)
     ax.set_aspect("equal")
     ax.set(xlabel="x (m; frames 0.35 m apart)", ylabel="z (m)", ylim=(-0.01, 0.36))
     save_figure(fig, out, "fig8")
+
+
+def _hand_height(path: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Mean height of both hands at every recorded step of a trajectory (NaN rows dropped)."""
+    path = path[np.isfinite(path).all(axis=1)]
+    return (path[:, 2] + path[:, 5]) / 2
