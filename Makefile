@@ -18,7 +18,10 @@ $(VENV)/.deps: pyproject.toml
 	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib tqdm gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm scikit-learn pandas "ray>=2.9"
 	touch $@
 
+# The old extension is unlinked first: maturin would overwrite it in place, under the feet of a
+# run still using it; unlinked, that run keeps its copy.
 $(VENV)/.built: $(VENV)/.deps Cargo.toml Cargo.lock $(shell find crates python -name '*.rs' -o -name '*.toml' -o -name '*.py' 2>/dev/null)
+	rm -f python/latentrl/_native.*.so
 	VIRTUAL_ENV=$(CURDIR)/$(VENV) $(VENV)/bin/maturin develop --release --quiet
 	touch $@
 
