@@ -4,7 +4,7 @@ over a latent space, saved as PNG + PDF."""
 from __future__ import annotations
 
 import io
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -145,6 +145,20 @@ def shown_paths(arrays: Mapping[str, np.ndarray]) -> tuple[np.ndarray | None, st
     if tests is not None:
         return tests, "frozen test episodes", "latent_test"
     return arrays.get("latent_paths"), "recorded training episodes", "latent"
+
+
+def side_view_stick(
+    ax: Axes,
+    edges: Sequence[tuple[str, str]],
+    poses: Mapping[str, NDArray[np.float64]],
+    colour: str,
+    dx: float = 0.0,
+) -> None:
+    """A robot's kinematic tree as a stick figure in the x–z plane: one segment per (parent,
+    child) link of `edges` between the origins of their world `poses` (4×4), shifted by `dx`."""
+    for parent, child in edges:
+        a, b = poses[parent][:3, 3], poses[child][:3, 3]
+        ax.plot([dx + a[0], dx + b[0]], [a[2], b[2]], "o-", color=colour, lw=2, ms=2)
 
 
 def save_figure(fig: Figure, out_dir: Path, name: str) -> list[Path]:

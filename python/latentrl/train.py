@@ -17,15 +17,14 @@ from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
-
 from tqdm import tqdm
 
 from latentrl import humanoid
+from latentrl._reference import value_function
 from latentrl.experiments import exp2, exp3
 from latentrl.experiments.presets import latent_box
 from latentrl.experiments.runner import END_CODES, RunTrials, Setup, run_in_process
 from latentrl.gplvm import GPLVM
-from latentrl._reference import value_function
 
 
 class Task(NamedTuple):
@@ -92,7 +91,7 @@ def train_latent_policy(
 ) -> LatentPolicy:
     """Trains the latent TD(0) learner of `task` through the physics sim in the latent space of
     `model`, a GPLVM fitted to postures of the task's robot (columns in its joint order:
-    `envs.TwoArmsEnv.joint_names`, `humanoid.model().joint_names`).
+    `experiments.exp2.JOINT_NAMES`, `humanoid.model().joint_names`).
 
     `preset` is ``"quick"`` (the experiment's smoke-test budget) or ``"paper"``; any `fields`
     of the experiment's preset override it (``trials=4, episodes=500, seed=1, ...``, see

@@ -100,19 +100,19 @@ class Exp3Preset:
     test_episodes: int = 20
     """Frozen test episodes per trial after training (no TD updates; ours: 20, Fig. 7d and 8
     draw the first ten)."""
-    physics_dt: float = 1.0 / 240.0
+    physics_dt: float = humanoid.PHYSICS["dt"]
     """Physics time step, s; one RL step = physics_dt × substeps = 0.05 s (ours, as Exp. 2)."""
     substeps: int = 12
     """Physics steps per RL step."""
-    solver_iterations: int = 1
+    solver_iterations: int = humanoid.PHYSICS["solver_iterations"]
     """rapier solver iterations per physics step (humanoid.PHYSICS)."""
-    pgs_iterations: int = 4
+    pgs_iterations: int = humanoid.PHYSICS["pgs_iterations"]
     """PGS passes per solver iteration (humanoid.PHYSICS: stands 10 s within 1 mm)."""
-    kp: float = 8.0
+    kp: float = humanoid.SERVO["kp"]
     """Servo stiffness of every joint, N·m/rad (humanoid.SERVO, SPEC §4.3's MuJoCo study)."""
-    kd: float = 0.1
+    kd: float = humanoid.SERVO["kd"]
     """Servo damping of every joint, N·m·s/rad (humanoid.SERVO)."""
-    max_force: float = 1.2
+    max_force: float = humanoid.SERVO["max_force"]
     """Servo torque cap, N·m (humanoid.SERVO, the URDF effort)."""
     curve_window: int = 500
     """Running-mean window of Fig. 7e (at most episodes // 5 for short runs)."""

@@ -16,7 +16,13 @@ from numpy.typing import NDArray
 from latentrl import humanoid
 from latentrl.experiments.exp1 import recorded_episodes
 from latentrl.experiments.exp3 import OBSTACLE, TASK_HEAD, Exp3Preset, Fitted, fit, rest_map, target
-from latentrl.plots import latent_run_figures, latent_value_panel, save_figure, shown_paths
+from latentrl.plots import (
+    latent_run_figures,
+    latent_value_panel,
+    save_figure,
+    shown_paths,
+    side_view_stick,
+)
 
 
 def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
@@ -122,9 +128,7 @@ def _fig8(arrays: Mapping[str, np.ndarray], paths: np.ndarray | None, returns_ke
             poses = h.link_poses(path[step, TASK_HEAD:], _base(path[step]))
             cx, _, cz, hx, _, hz = OBSTACLE
             ax.add_patch(Rectangle((dx + cx - hx, cz - hz), 2 * hx, 2 * hz, color="0.5", alpha=0.4))
-            for parent, child in h.edges:
-                a, b = poses[parent][:3, 3], poses[child][:3, 3]
-                ax.plot([dx + a[0], dx + b[0]], [a[2], b[2]], "o-", color="C0", lw=2, ms=2)
+            side_view_stick(ax, h.edges, poses, "C0", dx)
             ax.text(dx + 0.05, 0.33, f"step {step}", fontsize=8, ha="center")
         ax.set_title(f"a learnt lift: recorded episode {int(recorded[best])} of trial 1 (return "
                      f"{returns[recorded[best]]:.1f}, hands {1e3 * rise[best]:.0f} mm up)")

@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from latentrl import _native
 from latentrl.experiments.fallcheck import FallCheckPreset, fit_coders, segment_targets
 from latentrl.humanoid import PHYSICS, SERVO, Humanoid, hull_margin, model, urdf_path
-from latentrl.plots import save_figure
+from latentrl.plots import save_figure, side_view_stick
 
 #: Sole links of the fall test and the support polygon (the first one is stood on at reset).
 SOLES = ("l_foot", "r_foot")
@@ -103,9 +103,7 @@ def _stick(ax: Axes, h: Humanoid, poses: dict[str, NDArray[np.float64]], colour:
         corners = h.sole_corners(poses, sole)
         face = np.array([corners[k] for k in (0, 4, 5, 1)])  # one side face: x-, x+ by z-, z+
         ax.fill(face[:, 0], face[:, 2], color=colour, alpha=0.6, lw=0)
-    for parent, child in h.edges:
-        a, b = poses[parent][:3, 3], poses[child][:3, 3]
-        ax.plot([a[0], b[0]], [a[2], b[2]], "o-", color=colour, lw=2, ms=2)
+    side_view_stick(ax, h.edges, poses, colour)
     com = h.com(poses)
     ax.plot([com[0]], [com[2]], "*", color="k", ms=7)
     ax.plot([com[0]], [0.0], "|", color="k", ms=8)
