@@ -110,3 +110,12 @@ def test_fig7a_frames_agree_with_the_table(tmp_path):
         assert abs(seen[method]["min_margin"] - rows[method]["sim_margin"]) < 1e-4
     assert seen["PCA"]["fell"] and seen["PCA"]["fall_time"] is not None
     assert not seen["GPLVM"]["fell"] and seen["GPLVM"]["base_height"] > 0.1
+
+
+@pytest.mark.parametrize("segment", [("pose", 7), ("line", 3), ("curve", 1)])
+def test_fig7a_rejects_unknown_segments(tmp_path, segment):
+    from latentrl.experiments.fallcheck_figures import fallcheck_frames
+
+    with pytest.raises(ValueError, match="segment must name one of"):
+        fallcheck_frames(tmp_path, segment=segment)
+    assert not list(tmp_path.iterdir())

@@ -22,7 +22,7 @@ from matplotlib.axes import Axes
 from numpy.typing import NDArray
 
 from latentrl import _native
-from latentrl.experiments.fallcheck import FallCheckPreset, fit_coders, segment_targets
+from latentrl.experiments.fallcheck import FallCheckPreset, fit_coders, segment_targets, segments
 from latentrl.humanoid import PHYSICS, SERVO, Humanoid, hull_margin, model, urdf_path
 from latentrl.plots import save_figure, side_view_stick
 
@@ -122,6 +122,8 @@ def fallcheck_frames(
     p = preset or FallCheckPreset()
     kind, i = segment
     name = f"pose {i}" if kind == "pose" else f"line {i}-{i + 1}"
+    if kind not in ("pose", "line") or name not in segments(p):
+        raise ValueError(f"segment must name one of {segments(p)} as ('pose', i) or ('line', i), got {segment!r}")
     X, coders = fit_coders(p)
     h = model()
     runs = {}
