@@ -90,6 +90,13 @@ def test_records_postures_and_echoes_the_config(fitted):
     assert config["target"] == pytest.approx(list(exp3.target()))
 
 
+def test_native_default_physics_is_the_python_one(fitted):
+    # Keys left out of `config` take the Rust defaults (sim::humanoid::sim_options): the same
+    # servo and physics as humanoid.SERVO / PHYSICS, which the Python side builds its Sims with.
+    config = run_lift_trials(str(humanoid.urdf_path()), **lift_kwargs(fitted, n_trials=1, episodes=1))["config"]
+    assert {k: config[k] for k in (*humanoid.SERVO, *humanoid.PHYSICS)} == {**humanoid.SERVO, **humanoid.PHYSICS}
+
+
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("exp3_quick")

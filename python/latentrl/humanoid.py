@@ -50,7 +50,8 @@ SERVO: ServoGains = {"kp": 8.0, "kd": 0.1, "max_force": 1.2}
 #: Physics of the humanoid: dt 1/240 s, 1 rapier solver iteration of 4 PGS passes. Each solver
 #: iteration refreshes the multibody's mass matrix (most of a step's cost), PGS passes do not:
 #: this stands 10 s (an Exp 3 episode at most) drifting 0.9 mm (4 iterations of 1 pass: 2.3 mm)
-#: at 0.3 × the cost; over 60 s it creeps 59 mm (4 × 1: 14 mm; benches/README.md).
+#: at 0.3 × the cost; over 60 s it creeps 59 mm (4 × 1: 14 mm; benches/README.md). The Rust side's
+#: defaults (`sim::humanoid::sim_options`) are the same SERVO and PHYSICS (tests/test_exp3.py).
 PHYSICS: PhysicsSettings = {"dt": 1.0 / 240.0, "solver_iterations": 1, "pgs_iterations": 4}
 
 

@@ -9,8 +9,8 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use sim::humanoid::reset_on_ground;
-use sim::{PdGains, PhysicsSim, RootMode, SimOptions, UrdfModel};
+use sim::humanoid::{reset_on_ground, sim_options};
+use sim::{PhysicsSim, SimOptions, UrdfModel};
 
 const KHR1HV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/khr1hv.urdf");
 const DEMOS: &str = concat!(
@@ -23,18 +23,12 @@ const STEPS: usize = 10;
 /// standing 10 s, so every timed step is of a standing robot.
 const RESTART_AFTER: f64 = 10.0;
 
+/// The humanoid of `sim::humanoid::sim_options` with `(solver iterations, PGS passes)`.
 fn humanoid((solver_iterations, pgs_iterations): (usize, usize)) -> PhysicsSim {
     let options = SimOptions {
-        root: RootMode::Floating,
-        ground: Some(0.0),
-        gains: PdGains {
-            kp: 8.0,
-            kd: 0.1,
-            max_force: 1.2,
-        },
         solver_iterations,
         pgs_iterations,
-        ..SimOptions::default()
+        ..sim_options()
     };
     PhysicsSim::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
 }

@@ -35,9 +35,8 @@ use nalgebra::Isometry3;
 use rand::{Rng, RngExt};
 
 use crate::error::{Result, SimError, check_finite};
-use crate::humanoid::{reset_on_ground, support_margin};
+use crate::humanoid::{self, reset_on_ground, support_margin};
 use crate::obstacles::{FallCriteria, Obstacle, ObstacleShape};
-use crate::pd::PdGains;
 use crate::plant::{Frame, PhysicsSim, SimOptions};
 use crate::urdf::{RootMode, UrdfModel};
 
@@ -123,18 +122,7 @@ impl Default for LiftConfig {
             start_posture: None,
             start_noise: 0.01,
             min_start_margin: 0.0,
-            sim: SimOptions {
-                root: RootMode::Floating,
-                ground: Some(0.0),
-                gains: PdGains {
-                    kp: 8.0,
-                    kd: 0.1,
-                    max_force: 1.2,
-                },
-                solver_iterations: 1,
-                pgs_iterations: 4,
-                ..SimOptions::default()
-            },
+            sim: humanoid::sim_options(),
         }
     }
 }

@@ -2,34 +2,23 @@
 //! servo-like PD at its home posture, and the shipped lift demos hold still.
 use std::time::Instant;
 
-use sim::humanoid::{FallCheckConfig, reset_on_ground, run_fall_check, support_margin};
-use sim::{PdGains, PhysicsSim, RootMode, SimOptions, UrdfModel};
+use sim::humanoid::{FallCheckConfig, reset_on_ground, run_fall_check, sim_options, support_margin};
+use sim::{PhysicsSim, SimOptions, UrdfModel};
 
 const KHR1HV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/khr1hv.urdf");
 
-/// Servo gains of the humanoid: kp 8 N·m/rad, kd 0.1 N·m·s/rad, torque capped at the URDF
-/// effort (1.2 N·m), the MuJoCo study's servo (SPEC §4.3).
-fn servo() -> PdGains {
-    PdGains {
-        kp: 8.0,
-        kd: 0.1,
-        max_force: 1.2,
-    }
+/// The humanoid with the physics of `sim::humanoid::sim_options`, or other iterations.
+fn humanoid(options: SimOptions) -> PhysicsSim {
+    PhysicsSim::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
 }
 
-/// The humanoid's physics (`latentrl.humanoid.PHYSICS`): 1 solver iteration of 4 PGS passes.
-const PHYSICS: (usize, usize) = (1, 4);
-
-fn humanoid((solver_iterations, pgs_iterations): (usize, usize)) -> PhysicsSim {
-    let options = SimOptions {
-        root: RootMode::Floating,
-        ground: Some(0.0),
-        gains: servo(),
-        solver_iterations,
-        pgs_iterations,
-        ..SimOptions::default()
-    };
-    PhysicsSim::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
+/// rapier's default solver (4 iterations of 1 PGS pass) with the humanoid's servos.
+fn rapier_default() -> SimOptions {
+    SimOptions {
+        solver_iterations: 4,
+        pgs_iterations: 1,
+        ..sim_options()
+    }
 }
 
 /// Postures of a shipped demo CSV (header of joint names in URDF order, one row each).
@@ -38,7 +27,7 @@ fn demos(file: &str) -> Vec<Vec<f64>> {
     let text = std::fs::read_to_string(path).expect("demo file");
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let sim = humanoid(PHYSICS);
+    let sim = humanoid(sim_options());
     let names = sim.model().joint_names();
     assert_eq!(header, names, "columns in URDF joint order");
     lines
@@ -48,7 +37,7 @@ fn demos(file: &str) -> Vec<Vec<f64>> {
 
 #[test]
 fn model_has_the_documented_size_and_mass() {
-    let mut sim = humanoid(PHYSICS);
+    let mut sim = humanoid(sim_options());
     assert_eq!(sim.num_joints(), 19);
     let home = vec![0.0; 19];
     reset_on_ground(&mut sim, &home, "l_foot", 0.0, 0.0).unwrap();
@@ -62,7 +51,7 @@ fn model_has_the_documented_size_and_mass() {
 fn every_demo_pose_holds_for_two_seconds() {
     for (file, heel) in [("khr1hv_lift_demos.csv", 0.045), ("khr1hv_lift_demos_heel.csv", 0.016)] {
         for (i, pose) in demos(file).iter().enumerate() {
-            let mut sim = humanoid(PHYSICS);
+            let mut sim = humanoid(sim_options());
             let config = FallCheckConfig {
                 hold: 2.0,
                 ..FallCheckConfig::default()
@@ -86,8 +75,9 @@ fn every_demo_pose_holds_for_two_seconds() {
 /// must hold the base within 3 mm (measured 0.9 mm; 4 × 1: 2.3 mm, 1 × 1: 19 mm).
 #[test]
 fn stands_for_ten_seconds_at_home_posture() {
-    for physics in [PHYSICS, (4, 1)] {
-        let mut sim = humanoid(physics);
+    for options in [sim_options(), rapier_default()] {
+        let physics = (options.solver_iterations, options.pgs_iterations);
+        let mut sim = humanoid(options.clone());
         let home = vec![0.0; 19];
         reset_on_ground(&mut sim, &home, "l_foot", 0.0, 5e-4).unwrap();
         let start = sim.base_pose().translation;
@@ -110,7 +100,7 @@ fn stands_for_ten_seconds_at_home_posture() {
         assert!(!report[0].fell, "{report:?}");
         assert!(report[0].min_margin > 0.03, "{report:?}");
         assert!(report[0].status.sole_tilt < 0.02, "{report:?}");
-        if physics == PHYSICS {
+        if options == sim_options() {
             assert!(drift < 3e-3, "base drifted {drift} m");
         }
     }
