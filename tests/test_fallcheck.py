@@ -12,7 +12,7 @@ from latentrl.experiments.fallcheck import (
     format_table,
     run_fallcheck,
 )
-from latentrl.humanoid import GRIP_WIDTH, demos_path, fall_check, model
+from latentrl.humanoid import GRIP_WIDTH, demos_path, fall_check, hull_margin, model
 
 
 def test_robot_has_the_documented_size():
@@ -44,15 +44,35 @@ def test_demos_grip_the_object_and_balance_as_documented(heel, margin):
 
 def test_demo_pose_holds_in_the_sim():
     X = load_demos(demos_path(heel=True)).postures
-    out = fall_check(X[0], X[:1], hold=2.0)
-    assert out.shape == (1, 6)
-    fell, min_margin, _, grip, _, base = out[0]
-    assert fell == 0 and min_margin > 0.01 and abs(grip) < 2e-3 and base > 0.1
+    out = fall_check(X[0], X[:1], hold=2.0).segments
+    assert out.shape == (1, 7)
+    fell, min_margin, _, grip, _, base, fall_time = out[0]
+    assert fell == 0 and min_margin > 0.01 and abs(grip) < 2e-3 and base > 0.1 and np.isnan(fall_time)
+
+
+def test_recorded_frames_place_the_robot_where_the_sim_has_it():
+    # The recorded base pose and joints, through the NumPy kinematics (independent of rapier),
+    # give the support margin and base height the Rust check measured at the end.
+    X = load_demos(demos_path(heel=True)).postures
+    h = model()
+    run = fall_check(X[0], X[:2], hold=0.5, record_times=[0.0, 0.3, 1.0, 5.0])
+    assert run.frames.shape == (3, 9 + 19)  # 5 s is past the end: no frame
+    np.testing.assert_allclose(run.frames[:, 0], [0.0, 0.3, 1.0], atol=4 / 240)
+    assert not run.frames[:, 1].any()
+    end = run.link_poses(2)
+    corners = np.array([c for s in ("l_foot", "r_foot") for c in h.sole_corners(end, s)])
+    touching = corners[corners[:, 2] <= corners[:, 2].min() + 2e-3]
+    assert abs(corners[:, 2].min()) < 2e-3  # on the floor
+    assert hull_margin(h.com(end)[:2], touching[:, :2]) == pytest.approx(run.segments[1, 2], abs=1e-6)
+    assert run.frames[2, 4] == pytest.approx(run.segments[1, 5])
+    np.testing.assert_allclose(run.frames[0, 9:], X[0], atol=1e-9)
 
 
 def test_fall_check_rejects_bad_shapes():
     with pytest.raises(ValueError, match="targets"):
         fall_check(np.zeros(19), np.zeros((2, 18)))
+    with pytest.raises(ValueError, match="record_times: expected finite times"):
+        fall_check(np.zeros(19), np.zeros((1, 19)), record_times=[float("nan")])
     assert "humanoid_fall_check" in _native.__all__
 
 

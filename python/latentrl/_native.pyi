@@ -169,10 +169,12 @@ def humanoid_fall_check(
     solver_iterations: int,
     pgs_iterations: int,
     grip_width: float,
-) -> NDArray[np.float64]:
+    record_times: Sequence[float] = ...,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Fall check of the floating humanoid (SPEC §4.3): stand at `start` (D,), hold each row
-    of `targets` (M, D) for `hold` s; returns (M, 6): fell, min margin, final margin, grip
-    error, max |grip error|, base height."""
+    of `targets` (M, D) for `hold` s. Returns (table (M, 7): fell, min margin, final margin,
+    grip error, max |grip error|, base height, fall time or NaN; frames (K, 9 + D) at the
+    reached `record_times`: time, fell, base position, base quaternion (x, y, z, w), joints)."""
 
 def run_bimanual_trials(
     learner: Literal["full", "latent"],

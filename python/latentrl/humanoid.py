@@ -16,11 +16,13 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
+from collections.abc import Sequence
 from pathlib import Path
-from typing import TypedDict
+from typing import NamedTuple, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
 
 from latentrl import _native
 
@@ -277,19 +279,42 @@ def model() -> Humanoid:
     return Humanoid.from_urdf()
 
 
+class FallCheck(NamedTuple):
+    """What `fall_check` saw."""
+
+    segments: NDArray[np.float64]
+    """(M, 7), one row per target: fell, min support margin, final support margin, grip
+    error at the end, max |grip error| (m), final base height (m), time of the fall (s since
+    the start; NaN while standing)."""
+    frames: NDArray[np.float64]
+    """(K, 9 + D), one per reached `record_times` entry, taken at the first check at or
+    after it: time (s), fell, base position (3), base quaternion (x, y, z, w), joints (D)."""
+
+    def link_poses(self, k: int) -> dict[str, NDArray[np.float64]]:
+        """World 4×4 pose of every link at frame `k` (the NumPy kinematics at its joints and
+        base pose)."""
+        frame = self.frames[k]
+        base = np.eye(4)
+        base[:3, :3] = Rotation.from_quat(frame[5:9]).as_matrix()
+        base[:3, 3] = frame[2:5]
+        return model().link_poses(frame[9:], base)
+
+
 def fall_check(
     start: NDArray[np.float64],
     targets: NDArray[np.float64],
     *,
     hold: float = 1.0,
     urdf: str | Path | None = None,
-) -> NDArray[np.float64]:
-    """Physics fall check (Rust): stand at `start`, hold each row of `targets` for `hold` s
-    with the SERVO gains. Returns (M, 6): fell, min margin, final margin, grip error,
-    max |grip error|, base height (see `_native.humanoid_fall_check`)."""
+    record_times: Sequence[float] = (),
+) -> FallCheck:
+    """Physics fall check (Rust `sim::humanoid::run_fall_check`): stand at `start`, hold each
+    row of `targets` for `hold` s with the SERVO gains and PHYSICS, checking every 4 physics
+    steps; records the robot at `record_times` (s) for pictures."""
     start = np.ascontiguousarray(start, dtype=np.float64)
     targets = np.ascontiguousarray(np.atleast_2d(targets), dtype=np.float64)
-    return _native.humanoid_fall_check(
+    table, frames = _native.humanoid_fall_check(
         str(urdf or urdf_path()), start, targets, hold=hold, grip_width=GRIP_WIDTH,
-        **SERVO, **PHYSICS,
+        record_times=[float(t) for t in record_times], **SERVO, **PHYSICS,
     )
+    return FallCheck(table, frames)

@@ -1,6 +1,6 @@
 //! Binding of `sim::humanoid`: the fall check of the floating humanoid in one call.
 
-use ::sim::humanoid::{FallCheckConfig, run_fall_check};
+use ::sim::humanoid::{FallCheckConfig, run_fall_check_observed};
 use ::sim::{PdGains, PhysicsSim, RootMode, SimOptions};
 use nalgebra::DMatrix;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -10,18 +10,27 @@ use crate::convert::{points, to_points};
 use crate::errors::{InvalidInputError, guard, sim_to_py};
 
 /// Columns of the returned table, one row per target.
-const COLUMNS: usize = 6;
+const COLUMNS: usize = 7;
+/// Columns of a recorded frame before the joint positions: time, fell, base x y z, base
+/// quaternion x y z w.
+const FRAME_HEAD: usize = 9;
+
+/// The fall check's per-target table and its recorded frames.
+type TableAndFrames<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 
 /// Runs the fall check of `sim::humanoid::run_fall_check` on the URDF at `urdf_path`
 /// (floating root, ground at z = 0): stand at `start` `(D,)`, hold each row of `targets`
 /// `(M, D)` for `hold` s under PD servos (`kp` N·m/rad, `kd` N·m·s/rad, torque capped at
 /// `max_force` and at the URDF effort), physics step `dt`, `solver_iterations`,
 /// `pgs_iterations`.
-/// Returns `(M, 6)`: fell (0/1), smallest support margin (m), final support margin (m),
-/// grip error at the end (hand distance − `grip_width`, m), largest |grip error| (m),
-/// base height at the end (m).
+/// Returns `(table, frames)`. `table` `(M, 7)`: fell (0/1), smallest support margin (m),
+/// final support margin (m), grip error at the end (hand distance − `grip_width`, m),
+/// largest |grip error| (m), base height at the end (m), time of the fall (s since the
+/// start, NaN while standing). `frames` `(K, 9 + D)`, one per `record_times` entry (s) that
+/// the check reaches, taken at the first check (every 4 physics steps) at or after it: time
+/// (s), fell (0/1), base position (m), base quaternion (x, y, z, w), joint positions.
 #[pyfunction]
-#[pyo3(signature = (urdf_path, start, targets, *, hold, kp, kd, max_force, dt, solver_iterations, pgs_iterations, grip_width))]
+#[pyo3(signature = (urdf_path, start, targets, *, hold, kp, kd, max_force, dt, solver_iterations, pgs_iterations, grip_width, record_times = Vec::new()))]
 #[allow(clippy::too_many_arguments)]
 pub fn humanoid_fall_check<'py>(
     py: Python<'py>,
@@ -36,8 +45,14 @@ pub fn humanoid_fall_check<'py>(
     solver_iterations: usize,
     pgs_iterations: usize,
     grip_width: f64,
-) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    record_times: Vec<f64>,
+) -> PyResult<TableAndFrames<'py>> {
     guard(|| {
+        if let Some(bad) = record_times.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
+            return Err(InvalidInputError::new_err(format!(
+                "record_times: expected finite times ≥ 0 s, got {bad}"
+            )));
+        }
         let start: Vec<f64> = start.as_array().iter().copied().collect();
         let targets = points("targets", &targets)?;
         if targets.nrows() != start.len() {
@@ -64,11 +79,24 @@ pub fn humanoid_fall_check<'py>(
             grip_width,
             ..FallCheckConfig::default()
         };
+        let mut pending: Vec<f64> = record_times.iter().map(|t| (t / dt).round()).collect();
+        pending.sort_by(|a, b| b.total_cmp(a));
+        let mut frames: Vec<f64> = Vec::new();
         let path = urdf_path.to_string();
         let reports = py
             .detach(|| {
                 let mut sim = PhysicsSim::from_urdf_file(&path, options)?;
-                run_fall_check(&mut sim, &start, &rows, &config)
+                run_fall_check_observed(&mut sim, &start, &rows, &config, |sim, fell| {
+                    let done = (sim.time() / dt).round();
+                    while pending.last().is_some_and(|&step| done >= step) {
+                        pending.pop();
+                        let base = sim.base_pose();
+                        frames.extend([sim.time(), f64::from(u8::from(fell))]);
+                        frames.extend(base.translation.vector.iter());
+                        frames.extend(base.rotation.coords.iter());
+                        frames.extend(sim.joint_positions());
+                    }
+                })
             })
             .map_err(sim_to_py)?;
         let mut out = DMatrix::zeros(COLUMNS, reports.len());
@@ -80,9 +108,12 @@ pub fn humanoid_fall_check<'py>(
                 r.grip_error,
                 r.max_grip_error,
                 r.status.base_height,
+                r.fall_time.unwrap_or(f64::NAN),
             ];
             out.column_mut(j).copy_from_slice(&row);
         }
-        to_points(py, out)
+        let width = FRAME_HEAD + start.len();
+        let frames = DMatrix::from_vec(width, frames.len() / width, frames);
+        Ok((to_points(py, out)?, to_points(py, frames)?))
     })
 }

@@ -98,6 +98,9 @@ pub struct SegmentReport {
     pub max_grip_error: f64,
     /// The fall status at the end of the segment.
     pub status: FallStatus,
+    /// Time since the check's start (s) of the first check that met the fall test, in this
+    /// segment or an earlier one; `None` while the robot stands.
+    pub fall_time: Option<f64>,
 }
 
 /// Centre of mass of the whole robot in world coordinates (m), from the URDF inertials.
@@ -274,6 +277,19 @@ pub fn run_fall_check(
     targets: &[Vec<f64>],
     config: &FallCheckConfig,
 ) -> Result<Vec<SegmentReport>> {
+    run_fall_check_observed(sim, start, targets, config, |_, _| {})
+}
+
+/// [`run_fall_check`] that also calls `observe(sim, fell)` after the reset and after every
+/// check (every `config.check_every` physics steps; `sim.time()` is the time since the start),
+/// e.g. to record the robot's poses for a picture.
+pub fn run_fall_check_observed(
+    sim: &mut PhysicsSim,
+    start: &[f64],
+    targets: &[Vec<f64>],
+    config: &FallCheckConfig,
+    mut observe: impl FnMut(&PhysicsSim, bool),
+) -> Result<Vec<SegmentReport>> {
     check_finite("hold", &[config.hold, config.grip_width])?;
     if config.hold <= 0.0 || config.check_every == 0 {
         return Err(SimError::Input(CoreError::InvalidParameter {
@@ -298,8 +314,9 @@ pub fn run_fall_check(
         d - config.grip_width
     };
     let steps = (config.hold / sim.options.dt).ceil() as usize;
-    let mut fell = false;
+    let mut fall_time = None;
     let mut out = Vec::with_capacity(targets.len());
+    observe(sim, false);
     for target in targets {
         sim.set_targets(target)?;
         let mut min_margin = f64::INFINITY;
@@ -312,16 +329,20 @@ pub fn run_fall_check(
             let margin = support_margin(sim, &config.soles)?;
             min_margin = min_margin.min(margin);
             max_grip = max_grip.max(grip(sim).abs());
-            fell |= sim.fall_status(&fall)?.fell;
+            if fall_time.is_none() && sim.fall_status(&fall)?.fell {
+                fall_time = Some(sim.time());
+            }
+            observe(sim, fall_time.is_some());
         }
         let status = sim.fall_status(&fall)?;
         out.push(SegmentReport {
-            fell,
+            fell: fall_time.is_some(),
             min_margin,
             final_margin: support_margin(sim, &config.soles)?,
             grip_error: grip(sim),
             max_grip_error: max_grip,
             status,
+            fall_time,
         });
     }
     Ok(out)

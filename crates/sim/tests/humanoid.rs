@@ -2,7 +2,9 @@
 //! servo-like PD at its home posture, and the shipped lift demos hold still.
 use std::time::Instant;
 
-use sim::humanoid::{FallCheckConfig, reset_on_ground, run_fall_check, sim_options, support_margin};
+use sim::humanoid::{
+    FallCheckConfig, reset_on_ground, run_fall_check, run_fall_check_observed, sim_options, support_margin,
+};
 use sim::{PhysicsSim, SimOptions, UrdfModel};
 
 const KHR1HV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/khr1hv.urdf");
@@ -104,4 +106,36 @@ fn stands_for_ten_seconds_at_home_posture() {
             assert!(drift < 3e-3, "base drifted {drift} m");
         }
     }
+}
+
+/// The observer sees the reset and every check, at increasing times, and observing does not
+/// change what the check reports.
+#[test]
+fn observed_fall_check_reports_what_the_plain_one_does() {
+    let home = vec![0.0; 19];
+    let config = FallCheckConfig {
+        hold: 0.5,
+        ..FallCheckConfig::default()
+    };
+    let plain = run_fall_check(
+        &mut humanoid(sim_options()),
+        &home,
+        &[home.clone(), home.clone()],
+        &config,
+    )
+    .unwrap();
+    let mut seen = Vec::new();
+    let mut sim = humanoid(sim_options());
+    let observed = run_fall_check_observed(&mut sim, &home, &[home.clone(), home.clone()], &config, |sim, fell| {
+        seen.push((sim.time(), fell, sim.base_pose().translation.z))
+    })
+    .unwrap();
+    assert_eq!(plain, observed);
+    let per_segment = (0.5 * 240.0_f64).ceil() as usize / config.check_every;
+    assert_eq!(seen.len(), 1 + 2 * per_segment);
+    assert_eq!(seen[0].0, 0.0);
+    assert!(seen.windows(2).all(|w| w[1].0 > w[0].0));
+    assert!((seen.last().unwrap().0 - 1.0).abs() < 1e-9, "{:?}", seen.last());
+    assert!(seen.iter().all(|&(_, fell, _)| !fell) && observed[1].fall_time.is_none());
+    assert_eq!(seen.last().unwrap().2, observed[1].status.base_height);
 }

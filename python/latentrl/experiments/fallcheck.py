@@ -126,7 +126,7 @@ def run_fallcheck(preset: FallCheckPreset | None = None) -> list[dict[str, Any]]
     for method in METHODS:
         for segment in segments(p):
             targets, control, hold = segment_targets(X, coders[method], segment, p)
-            sim = fall_check(targets[0], targets, hold=hold)
+            sim = fall_check(targets[0], targets, hold=hold).segments
             rows.append(_row(method, segment, targets, control, sim, model()))
     return rows
 
