@@ -13,10 +13,10 @@ a negative pitch swings a hanging limb forward; knees bend with positive angles.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
-from collections.abc import Sequence
 from pathlib import Path
 from typing import NamedTuple, TypedDict
 

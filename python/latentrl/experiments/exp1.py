@@ -16,6 +16,7 @@ import numpy as np
 
 from latentrl import _native
 from latentrl.datasets import bimanual_pairs
+from latentrl.experiments.latent_runs import gplvm_info, recorded_episodes
 from latentrl.experiments.presets import check_floats, check_ints, latent_box
 from latentrl.experiments.runner import RunTrials, Setup, run_rl
 from latentrl.gplvm import GPLVM
@@ -93,13 +94,6 @@ class Exp1Preset:
         return dataclasses.replace(cls(), trials=3, episodes=500, step_fraction=0.5)
 
 
-def recorded_episodes(episodes: int) -> list[int]:
-    """Episodes whose hand paths are kept: three during learning (Fig. 4b), the last three (4c)."""
-    during = [0, episodes // 10, episodes // 2]
-    after = list(range(max(episodes - 3, 0), episodes))
-    return sorted(set(during + after))
-
-
 def native_config(preset: Exp1Preset) -> dict[str, Any]:
     """The preset in the native call's configuration keys."""
     return {
@@ -141,13 +135,7 @@ def setup(preset: Exp1Preset) -> Setup:
         "full": partial(run, "full"),
     }
     info = {
-        "gplvm": {
-            "nll": model.nll_,
-            "theta": model.theta_,
-            "converged": model.converged_,
-            "n_iter": model.n_iter_,
-            "encoder_theta": model.encoder_theta_,
-        },
+        "gplvm": gplvm_info(model),
         "latent_box": {"low": low, "high": high},
         "recorded_episodes": recorded_episodes(preset.episodes),
     }

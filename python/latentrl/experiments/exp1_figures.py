@@ -9,7 +9,8 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from latentrl.experiments.exp1 import OBSTACLE_CENTRE, TARGET, Exp1Preset, recorded_episodes
+from latentrl.experiments.exp1 import OBSTACLE_CENTRE, TARGET, Exp1Preset
+from latentrl.experiments.latent_runs import recorded_episodes
 from latentrl.plots import hand_paths, learning_curves, save_figure
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from functools import lru_cache, partial
+from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -29,7 +29,12 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl.datasets import arm_postures
-from latentrl.experiments.exp1 import recorded_episodes
+from latentrl.experiments.latent_runs import (
+    gplvm_info,
+    recorded_episodes,
+    recorded_tests,
+    robot_learner,
+)
 from latentrl.experiments.presets import check_floats, check_ints, latent_box
 from latentrl.experiments.runner import RunTrials, Setup, run_rl
 from latentrl.gplvm import GPLVM
@@ -200,29 +205,10 @@ def urdf_path() -> str:
     return str(resources.files("latentrl") / "data" / URDF)
 
 
-def recorded_tests(test_episodes: int) -> list[int]:
-    """Test episodes whose hand paths are kept (Fig. 6c): the first ten."""
-    return list(range(min(10, test_episodes)))
-
-
 def learner(preset: Exp2Preset, model: GPLVM, low: NDArray[np.float64], high: NDArray[np.float64]) -> RunTrials:
     """The latent learner of `preset` on the two arms, in the latent box (`low`, `high`) of a
     fitted GPLVM of arm postures (columns `JOINT_NAMES`)."""
-    return partial(
-        _native.run_arms_trials,
-        urdf_path(),
-        decoder=model.decoder_,
-        encoder=model.encoder_,
-        latent_low=low,
-        latent_high=high,
-        episodes=preset.episodes,
-        base_seed=preset.seed,
-        config=native_config(preset),
-        record_episodes=recorded_episodes(preset.episodes),
-        test_episodes=preset.test_episodes,
-        record_test_episodes=recorded_tests(preset.test_episodes),
-        return_weights=True,
-    )
+    return robot_learner(_native.run_arms_trials, urdf_path(), preset, model, (low, high), native_config(preset))
 
 
 def setup(preset: Exp2Preset) -> Setup:
@@ -230,13 +216,7 @@ def setup(preset: Exp2Preset) -> Setup:
     fitted = fit(preset)
     model = fitted.model
     info = {
-        "gplvm": {
-            "nll": model.nll_,
-            "theta": model.theta_,
-            "converged": model.converged_,
-            "n_iter": model.n_iter_,
-            "encoder_theta": model.encoder_theta_,
-        },
+        "gplvm": gplvm_info(model),
         "latent_box": {"low": fitted.low, "high": fitted.high},
         "recorded_episodes": recorded_episodes(preset.episodes),
         "recorded_test_episodes": recorded_tests(preset.test_episodes),

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from functools import lru_cache, partial
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +30,12 @@ from numpy.typing import NDArray
 
 from latentrl import _native, humanoid
 from latentrl.demos import load_demos
-from latentrl.experiments.exp1 import recorded_episodes
+from latentrl.experiments.latent_runs import (
+    gplvm_info,
+    recorded_episodes,
+    recorded_tests,
+    robot_learner,
+)
 from latentrl.experiments.presets import check_floats, check_ints, latent_box
 from latentrl.experiments.runner import RunTrials, Setup, run_rl
 from latentrl.gplvm import GPLVM
@@ -219,30 +224,12 @@ def _fit(seed: int, max_iter: int, margin: float) -> Fitted:
     return Fitted(demos, model, low, high)
 
 
-def recorded_tests(test_episodes: int) -> list[int]:
-    """Test episodes whose paths are kept (Fig. 7d, 8): the first ten."""
-    return list(range(min(10, test_episodes)))
-
-
 def learner(preset: Exp3Preset, model: GPLVM, low: NDArray[np.float64], high: NDArray[np.float64]) -> RunTrials:
     """The latent learner of `preset` on the humanoid, in the latent box (`low`, `high`) of a
     GPLVM fitted to lift postures (19 joints, `humanoid.model().joint_names` order); the
     "demo" start uses the training posture `start_demo`."""
-    return partial(
-        _native.run_lift_trials,
-        str(humanoid.urdf_path()),
-        decoder=model.decoder_,
-        encoder=model.encoder_,
-        latent_low=low,
-        latent_high=high,
-        episodes=preset.episodes,
-        base_seed=preset.seed,
-        config=native_config(preset, model.X_train_[preset.start_demo]),
-        record_episodes=recorded_episodes(preset.episodes),
-        test_episodes=preset.test_episodes,
-        record_test_episodes=recorded_tests(preset.test_episodes),
-        return_weights=True,
-    )
+    config = native_config(preset, model.X_train_[preset.start_demo])
+    return robot_learner(_native.run_lift_trials, str(humanoid.urdf_path()), preset, model, (low, high), config)
 
 
 def setup(preset: Exp3Preset) -> Setup:
@@ -250,13 +237,7 @@ def setup(preset: Exp3Preset) -> Setup:
     fitted = fit(preset)
     model = fitted.model
     info = {
-        "gplvm": {
-            "nll": model.nll_,
-            "theta": model.theta_,
-            "converged": model.converged_,
-            "n_iter": model.n_iter_,
-            "encoder_theta": model.encoder_theta_,
-        },
+        "gplvm": gplvm_info(model),
         "latent_box": {"low": fitted.low, "high": fitted.high},
         "demo_latent": model.Z_,
         "recorded_episodes": recorded_episodes(preset.episodes),

@@ -14,8 +14,8 @@ from matplotlib.patches import Rectangle
 from numpy.typing import NDArray
 
 from latentrl import humanoid
-from latentrl.experiments.exp1 import recorded_episodes
 from latentrl.experiments.exp3 import OBSTACLE, TASK_HEAD, Exp3Preset, Fitted, fit, rest_map, target
+from latentrl.experiments.latent_runs import recorded_episodes
 from latentrl.plots import (
     latent_run_figures,
     latent_value_panel,
