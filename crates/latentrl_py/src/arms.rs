@@ -7,9 +7,9 @@ use latent_core::LearnerConfig;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{guard, sim_to_py};
-use crate::rl::{RunArgs, apply_config_dict, echo_learner, float, floats, invalid, type_name};
-use crate::simconfig::{echo_sim, run_latent_2d, set_sim_key, string, urdf_model};
+use crate::errors::sim_to_py;
+use crate::rl::{apply_config_dict, echo_learner, float, floats, invalid, type_name};
+use crate::simconfig::{echo_sim, robot_trials, set_sim_key, string};
 
 /// The plant keys of Experiment 2's config dict, in the order they are documented and echoed.
 const ARMS_KEYS: [&str; 17] = [
@@ -104,74 +104,34 @@ fn echo_config<'py>(py: Python<'py>, plant: &ArmsConfig, learner: &LearnerConfig
     Ok(d)
 }
 
-/// Runs Experiment 2 (SPEC §4.2, paper Fig. 6) trials in parallel in Rust: two planar arms
-/// from `urdf`, simulated with rapier3d and PD servos, learning in a 2-D GPLVM latent space
-/// (8 actions: orthogonal + diagonal; 20 × 20 RBFs over [latent_low, latent_high]); one
-/// physics world per trial.
-///
-/// urdf: path (str or os.PathLike) of the arms' URDF, or its XML text.
-/// decoder, encoder: GpMap latent (2) → posture (joints) and posture → latent.
-/// latent_low, latent_high: (2,) corners of the latent box.
-/// n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
-///     record_test_episodes, return_weights, progress: as for run_bimanual_trials. Test
-///     episodes start only with both hands below the walls.
-/// config: overrides of the defaults (SPEC §4.2 table) — plant: target ([-0.05, 0.47,
-///     0.05, 0.47]), theta (0.35), length_scale (0.3 m), walls ([[-1, 0.30, -0.36, 0.37],
-///     [-0.06, 0.30, 1, 0.37]], each [x_min, y_min, x_max, y_max], tested on the hand
-///     positions only), grip ([0.1, 0]), drop_tolerance (0.005), penalty (-1), reached_rms
-///     (0.05), left_hand / right_hand ("left_hand" / "right_hand", URDF links),
-///     start_posture (the plant's own start, used with start="plant"), dt (1/240),
-///     substeps (12), solver_iterations (2), kp (5000), kd (50); learner (paper Exp. 2):
-///     alpha (0.8), gamma (0.99), initial_weight (0), beta (20), step_fraction (0.2),
-///     max_steps (1000), centres_per_dim (20), rbf_width (1), rbf_cutoff (3),
-///     variance_threshold (None), start ("uniform" | "plant"), max_start_draws (1000).
-///     Unknown keys raise InvalidInputError.
-///
-/// Returns the dict of run_bimanual_trials ("passed": both hands below the walls at the
-/// start and above them at some step), trajectories as hands (x_L, y_L, x_R, y_R), and
-/// "config" with every key above.
-#[pyfunction]
-#[pyo3(signature = (
-    urdf, *, decoder, encoder, latent_low, latent_high, n_trials, episodes, base_seed,
-    first_trial = None, config = None, record_episodes = None, test_episodes = None,
-    record_test_episodes = None, return_weights = false, progress = None,
-))]
-#[allow(clippy::too_many_arguments)]
-pub fn run_arms_trials<'py>(
-    py: Python<'py>,
-    urdf: &Bound<'py, PyAny>,
-    decoder: Bound<'py, PyAny>,
-    encoder: Bound<'py, PyAny>,
-    latent_low: &Bound<'py, PyAny>,
-    latent_high: &Bound<'py, PyAny>,
-    n_trials: &Bound<'py, PyAny>,
-    episodes: &Bound<'py, PyAny>,
-    base_seed: &Bound<'py, PyAny>,
-    first_trial: Option<&Bound<'py, PyAny>>,
-    config: Option<&Bound<'py, PyAny>>,
-    record_episodes: Option<&Bound<'py, PyAny>>,
-    test_episodes: Option<&Bound<'py, PyAny>>,
-    record_test_episodes: Option<&Bound<'py, PyAny>>,
-    return_weights: bool,
-    progress: Option<Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    guard(|| {
-        #[rustfmt::skip]
-        let run = RunArgs { n_trials, episodes, base_seed, first_trial, config, record_episodes, test_episodes,
-                            record_test_episodes, return_weights, progress }.check()?;
-        let (plant, learner_config) = apply_config(run.config.as_ref())?;
-        let model = urdf_model(urdf)?;
-        let make_plant = |_| ArmsPlant::new(model.clone(), plant.clone());
-        let out = run_latent_2d(
-            py,
-            &run,
-            [decoder, encoder],
-            [latent_low, latent_high],
-            "for the arms",
-            &learner_config,
-            make_plant,
-        )?;
-        out.set_item("config", echo_config(py, &plant, &learner_config)?)?;
-        Ok(out)
-    })
+robot_trials! {
+    /// Runs Experiment 2 (SPEC §4.2, paper Fig. 6) trials in parallel in Rust: two planar arms
+    /// from `urdf`, simulated with rapier3d and PD servos, learning in a 2-D GPLVM latent space
+    /// (8 actions: orthogonal + diagonal; 20 × 20 RBFs over [latent_low, latent_high]); one
+    /// physics world per trial.
+    ///
+    /// urdf: path (str or os.PathLike) of the arms' URDF, or its XML text.
+    /// decoder, encoder: GpMap latent (2) → posture (joints) and posture → latent.
+    /// latent_low, latent_high: (2,) corners of the latent box.
+    /// n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
+    ///     record_test_episodes, return_weights, progress: as for run_bimanual_trials. Test
+    ///     episodes start only with both hands below the walls.
+    /// config: overrides of the defaults (SPEC §4.2 table) — plant: target ([-0.05, 0.47,
+    ///     0.05, 0.47]), theta (0.35), length_scale (0.3 m), walls ([[-1, 0.30, -0.36, 0.37],
+    ///     [-0.06, 0.30, 1, 0.37]], each [x_min, y_min, x_max, y_max], tested on the hand
+    ///     positions only), grip ([0.1, 0]), drop_tolerance (0.005), penalty (-1), reached_rms
+    ///     (0.05), left_hand / right_hand ("left_hand" / "right_hand", URDF links),
+    ///     start_posture (the plant's own start, used with start="plant"), dt (1/240),
+    ///     substeps (12), solver_iterations (2), kp (5000), kd (50); learner (paper Exp. 2):
+    ///     alpha (0.8), gamma (0.99), initial_weight (0), beta (20), step_fraction (0.2),
+    ///     max_steps (1000), centres_per_dim (20), rbf_width (1), rbf_cutoff (3),
+    ///     variance_threshold (None), start ("uniform" | "plant"), max_start_draws (1000).
+    ///     Unknown keys raise InvalidInputError.
+    ///
+    /// Returns the dict of run_bimanual_trials ("passed": both hands below the walls at the
+    /// start and above them at some step), trajectories as hands (x_L, y_L, x_R, y_R), and
+    /// "config" with every key above.
+    run_arms_trials,
+    ArmsPlant,
+    "for the arms"
 }

@@ -8,9 +8,9 @@ use latent_core::LearnerConfig;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::errors::{guard, sim_to_py};
-use crate::rl::{RunArgs, apply_config_dict, echo_learner, float, floats, invalid, type_name};
-use crate::simconfig::{echo_sim, run_latent_2d, set_sim_key, string, urdf_model};
+use crate::errors::sim_to_py;
+use crate::rl::{apply_config_dict, echo_learner, float, floats, invalid, type_name};
+use crate::simconfig::{echo_sim, robot_trials, set_sim_key, string};
 
 /// The plant keys of Experiment 3's config dict, in the order they are documented and echoed.
 const LIFT_KEYS: [&str; 22] = [
@@ -155,76 +155,36 @@ fn echo_config<'py>(py: Python<'py>, plant: &LiftConfig, learner: &LearnerConfig
     Ok(d)
 }
 
-/// Runs Experiment 3 (SPEC §4.3, paper Fig. 7b–e, 8) trials in parallel in Rust: the
-/// floating humanoid from `urdf` standing on a floor, simulated with rapier3d and servo PD,
-/// learning in a 2-D GPLVM latent space (8 actions: orthogonal + diagonal; 20 × 20 RBFs
-/// over [latent_low, latent_high]); one plant per trial and a fresh physics world per
-/// episode.
-///
-/// urdf: path (str or os.PathLike) of the humanoid's URDF, or its XML text.
-/// decoder, encoder: GpMap latent (2) → posture (19 joints) and posture → latent.
-/// latent_low, latent_high: (2,) corners of the latent box.
-/// n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
-///     record_test_episodes, return_weights, progress: as for run_bimanual_trials.
-/// config: overrides of the defaults (docs/exp3.md) — plant: target (h*, 6 numbers: both
-///     hands' x, y, z), theta (0.35), length_scale (0.1 m), grip_width (0.10),
-///     drop_tolerance (0.02), penalty (-1), reached_rms (0.02), hands (["l_hand",
-///     "r_hand"]), soles (["l_foot", "r_foot"]), max_sole_tilt (20° in rad),
-///     base_height_fraction (0.5), obstacles ([[0.215, 0, 0.175, 0.05, 0.12, 0.125]]: axis-
-///     aligned sensor boxes [cx, cy, cz, hx, hy, hz]), start_posture (None = home; the
-///     plant's own start, used with start="plant"), start_noise (0.01 rad), min_start_margin
-///     (0 m), dt (1/240), substeps (12), solver_iterations (1), pgs_iterations (4), kp (8),
-///     kd (0.1), max_force
-///     (1.2 N·m); learner: alpha (0.8), gamma (0.99), initial_weight (0), beta (20),
-///     step_fraction (0.2), max_steps (200), centres_per_dim (20), rbf_width (1),
-///     rbf_cutoff (3), variance_threshold (None), start ("uniform" | "plant"),
-///     max_start_draws (1000). Unknown keys raise InvalidInputError.
-///
-/// Returns the dict of run_bimanual_trials ("passed" always False), trajectories rows of
-/// 32 columns: hands (x_L, y_L, z_L, x_R, y_R, z_R), base position (3), base orientation
-/// quaternion (x, y, z, w), the 19 joint angles; and "config" with every key above.
-#[pyfunction]
-#[pyo3(signature = (
-    urdf, *, decoder, encoder, latent_low, latent_high, n_trials, episodes, base_seed,
-    first_trial = None, config = None, record_episodes = None, test_episodes = None,
-    record_test_episodes = None, return_weights = false, progress = None,
-))]
-#[allow(clippy::too_many_arguments)]
-pub fn run_lift_trials<'py>(
-    py: Python<'py>,
-    urdf: &Bound<'py, PyAny>,
-    decoder: Bound<'py, PyAny>,
-    encoder: Bound<'py, PyAny>,
-    latent_low: &Bound<'py, PyAny>,
-    latent_high: &Bound<'py, PyAny>,
-    n_trials: &Bound<'py, PyAny>,
-    episodes: &Bound<'py, PyAny>,
-    base_seed: &Bound<'py, PyAny>,
-    first_trial: Option<&Bound<'py, PyAny>>,
-    config: Option<&Bound<'py, PyAny>>,
-    record_episodes: Option<&Bound<'py, PyAny>>,
-    test_episodes: Option<&Bound<'py, PyAny>>,
-    record_test_episodes: Option<&Bound<'py, PyAny>>,
-    return_weights: bool,
-    progress: Option<Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
-    guard(|| {
-        #[rustfmt::skip]
-        let run = RunArgs { n_trials, episodes, base_seed, first_trial, config, record_episodes, test_episodes,
-                            record_test_episodes, return_weights, progress }.check()?;
-        let (plant, learner_config) = apply_config(run.config.as_ref())?;
-        let model = urdf_model(urdf)?;
-        let make_plant = |_| LiftPlant::new(model.clone(), plant.clone());
-        let out = run_latent_2d(
-            py,
-            &run,
-            [decoder, encoder],
-            [latent_low, latent_high],
-            "for the humanoid",
-            &learner_config,
-            make_plant,
-        )?;
-        out.set_item("config", echo_config(py, &plant, &learner_config)?)?;
-        Ok(out)
-    })
+robot_trials! {
+    /// Runs Experiment 3 (SPEC §4.3, paper Fig. 7b–e, 8) trials in parallel in Rust: the
+    /// floating humanoid from `urdf` standing on a floor, simulated with rapier3d and servo PD,
+    /// learning in a 2-D GPLVM latent space (8 actions: orthogonal + diagonal; 20 × 20 RBFs
+    /// over [latent_low, latent_high]); one plant per trial and a fresh physics world per
+    /// episode.
+    ///
+    /// urdf: path (str or os.PathLike) of the humanoid's URDF, or its XML text.
+    /// decoder, encoder: GpMap latent (2) → posture (19 joints) and posture → latent.
+    /// latent_low, latent_high: (2,) corners of the latent box.
+    /// n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
+    ///     record_test_episodes, return_weights, progress: as for run_bimanual_trials.
+    /// config: overrides of the defaults (docs/exp3.md) — plant: target (h*, 6 numbers: both
+    ///     hands' x, y, z), theta (0.35), length_scale (0.1 m), grip_width (0.10),
+    ///     drop_tolerance (0.02), penalty (-1), reached_rms (0.02), hands (["l_hand",
+    ///     "r_hand"]), soles (["l_foot", "r_foot"]), max_sole_tilt (20° in rad),
+    ///     base_height_fraction (0.5), obstacles ([[0.215, 0, 0.175, 0.05, 0.12, 0.125]]: axis-
+    ///     aligned sensor boxes [cx, cy, cz, hx, hy, hz]), start_posture (None = home; the
+    ///     plant's own start, used with start="plant"), start_noise (0.01 rad), min_start_margin
+    ///     (0 m), dt (1/240), substeps (12), solver_iterations (1), pgs_iterations (4), kp (8),
+    ///     kd (0.1), max_force
+    ///     (1.2 N·m); learner: alpha (0.8), gamma (0.99), initial_weight (0), beta (20),
+    ///     step_fraction (0.2), max_steps (200), centres_per_dim (20), rbf_width (1),
+    ///     rbf_cutoff (3), variance_threshold (None), start ("uniform" | "plant"),
+    ///     max_start_draws (1000). Unknown keys raise InvalidInputError.
+    ///
+    /// Returns the dict of run_bimanual_trials ("passed" always False), trajectories rows of
+    /// 32 columns: hands (x_L, y_L, z_L, x_R, y_R, z_R), base position (3), base orientation
+    /// quaternion (x, y, z, w), the 19 joint angles; and "config" with every key above.
+    run_lift_trials,
+    LiftPlant,
+    "for the humanoid"
 }

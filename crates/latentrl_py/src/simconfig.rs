@@ -100,3 +100,61 @@ where
     })?;
     pack_results(py, &results, &template, options, task_dim)
 }
+
+/// Defines the `#[pyfunction]` `$name(urdf, *, decoder, encoder, latent_low, latent_high,
+/// n_trials, episodes, base_seed, first_trial, config, record_episodes, test_episodes,
+/// record_test_episodes, return_weights, progress)` of one URDF robot: the invoking module's
+/// `apply_config` turns `config` into the plant's and learner's configs, `$plant::new(model,
+/// config)` builds a plant per trial, [`run_latent_2d`] runs them, and the module's
+/// `echo_config` fills the result's "config". `$context` names the robot in error messages.
+macro_rules! robot_trials {
+    ($(#[$doc:meta])* $name:ident, $plant:ident, $context:literal) => {
+        $(#[$doc])*
+        #[pyfunction]
+        #[pyo3(signature = (
+            urdf, *, decoder, encoder, latent_low, latent_high, n_trials, episodes, base_seed,
+            first_trial = None, config = None, record_episodes = None, test_episodes = None,
+            record_test_episodes = None, return_weights = false, progress = None,
+        ))]
+        #[allow(clippy::too_many_arguments)]
+        pub fn $name<'py>(
+            py: Python<'py>,
+            urdf: &Bound<'py, PyAny>,
+            decoder: Bound<'py, PyAny>,
+            encoder: Bound<'py, PyAny>,
+            latent_low: &Bound<'py, PyAny>,
+            latent_high: &Bound<'py, PyAny>,
+            n_trials: &Bound<'py, PyAny>,
+            episodes: &Bound<'py, PyAny>,
+            base_seed: &Bound<'py, PyAny>,
+            first_trial: Option<&Bound<'py, PyAny>>,
+            config: Option<&Bound<'py, PyAny>>,
+            record_episodes: Option<&Bound<'py, PyAny>>,
+            test_episodes: Option<&Bound<'py, PyAny>>,
+            record_test_episodes: Option<&Bound<'py, PyAny>>,
+            return_weights: bool,
+            progress: Option<Bound<'py, PyAny>>,
+        ) -> PyResult<Bound<'py, PyDict>> {
+            $crate::errors::guard(|| {
+                #[rustfmt::skip]
+                let run = $crate::rl::RunArgs { n_trials, episodes, base_seed, first_trial, config, record_episodes,
+                                                test_episodes, record_test_episodes, return_weights, progress }.check()?;
+                let (plant, learner_config) = apply_config(run.config.as_ref())?;
+                let model = $crate::simconfig::urdf_model(urdf)?;
+                let make_plant = |_| $plant::new(model.clone(), plant.clone());
+                let out = $crate::simconfig::run_latent_2d(
+                    py,
+                    &run,
+                    [decoder, encoder],
+                    [latent_low, latent_high],
+                    $context,
+                    &learner_config,
+                    make_plant,
+                )?;
+                out.set_item("config", echo_config(py, &plant, &learner_config)?)?;
+                Ok(out)
+            })
+        }
+    };
+}
+pub(crate) use robot_trials;
