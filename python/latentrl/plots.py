@@ -52,8 +52,10 @@ def hand_paths(
     *,
     target: NDArray[np.float64],
     discs: tuple[tuple[float, float, float], ...] = (),
+    labels: Sequence[str] = (),
 ) -> None:
-    """Paths of both hands, `paths` (K, steps, 4) as (x_L, y_L, x_R, y_R), NaN-padded; discs (x, y, r)."""
+    """Paths of both hands, `paths` (K, steps, 4) as (x_L, y_L, x_R, y_R), NaN-padded; discs (x, y, r);
+    with `labels` (one per path) a legend of the paths beside the axes."""
     for x, y, r in discs:
         ax.add_patch(Circle((x, y), r, color="0.6", alpha=0.6))
     for k, path in enumerate(paths):
@@ -61,10 +63,12 @@ def hand_paths(
         if path.size == 0:
             continue
         shade = plt.cm.viridis(k / max(len(paths) - 1, 1))
-        ax.plot(path[:, 0], path[:, 1], color=shade, lw=1)
+        ax.plot(path[:, 0], path[:, 1], color=shade, lw=1, label=labels[k] if labels else None)
         ax.plot(path[:, 2], path[:, 3], color=shade, lw=1, ls="--")
         ax.plot(path[0, [0, 2]], path[0, [1, 3]], "o", color=shade, ms=3)
     ax.plot(target[[0, 2]], target[[1, 3]], "r*", ms=10, label="target")
+    if labels:
+        ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     ax.set_aspect("equal")
     ax.set_xlabel("x")
     ax.set_ylabel("y")

@@ -22,6 +22,7 @@ from latentrl.experiments.exp2 import (
     fit,
     in_walls,
 )
+from latentrl.experiments.latent_runs import recorded_episodes
 from latentrl.experiments.presets import latent_box
 from latentrl.pca import PCA
 from latentrl.plots import (
@@ -43,9 +44,10 @@ def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], out: Path) -> 
     )
     fig, ax = plt.subplots(figsize=(6, 4.5))
     _walls(ax)
-    paths, label, _ = shown_paths(arrays)
+    paths, label, key = shown_paths(arrays)
     if paths is not None:
-        hand_paths(ax, paths[0], target=TARGET)
+        episodes = recorded_episodes(preset.episodes) if key == "latent" else []
+        hand_paths(ax, paths[0], target=TARGET, labels=[f"episode {e + 1}" for e in episodes])
     ax.set_title(f"hand paths, {label} (trial 1); dashed: right hand")
     ax.set_xlim(-0.65, 0.6)
     ax.set_ylim(-0.05, 0.65)
