@@ -22,14 +22,19 @@ def tutorial() -> str:
     return block.group(1)
 
 
-def test_readme_tutorial_learns(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_readme_tutorial_learns(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     monkeypatch.chdir(tmp_path)
     scope: dict[str, object] = {}
     exec(compile(tutorial(), "README tutorial", "exec"), scope)
+    # the progress bar counts 2 trials × (150 training + 50 frozen test episodes)
+    assert "400/400" in capsys.readouterr().err
     policy = scope["policy"]
     early, late = policy.returns[:, :25].mean(), policy.returns[:, -25:].mean()  # type: ignore[attr-defined]
     assert late > 2 * early, (early, late)
     assert policy.reached[:, -25:].mean() > 0.5  # type: ignore[attr-defined]
+    assert policy.test_returns.shape == (2, 50) and policy.test_reached.mean() > 0.5  # type: ignore[attr-defined]
     assert scope["values"].shape == (123,)  # type: ignore[attr-defined]
     assert (tmp_path / "postures.csv").is_file()
 
@@ -50,6 +55,7 @@ def test_same_seed_same_policy_and_value_matches_weights(arms_model: GPLVM) -> N
     np.testing.assert_array_equal(runs[0].weights, runs[1].weights)
     assert not np.array_equal(runs[0].returns, runs[2].returns)
     assert runs[0].returns.shape == runs[0].ends.shape == (2, 3)
+    assert runs[0].test_returns.shape == runs[0].test_reached.shape == (2, 0)
     assert sum(runs[0].end_counts().values()) == 6
     policy = runs[0]
     assert policy.value(arms_model.Z_, trial=1).shape == (40,)

@@ -23,7 +23,7 @@ from latentrl import humanoid
 from latentrl._reference import value_function
 from latentrl.experiments import exp2, exp3
 from latentrl.experiments.presets import latent_box
-from latentrl.experiments.runner import END_CODES, RunTrials, Setup, run_in_process
+from latentrl.experiments.runner import END_CODES, RunTrials, Setup, episodes_per_trial, run_in_process
 from latentrl.gplvm import GPLVM
 
 
@@ -61,6 +61,13 @@ class LatentPolicy:
     """How every training episode ended, a code of `END_CODES`."""
     reached: NDArray[np.bool_]
     """Whether the hands came within `reach_radius` of the target in each episode."""
+    test_returns: NDArray[np.float64]
+    """Return of every frozen test episode after training (the learnt weights, no TD updates,
+    starts as the preset's `test_episodes` say), each (trials, test_episodes)."""
+    test_ends: NDArray[np.int8]
+    """How every frozen test episode ended, a code of `END_CODES`."""
+    test_reached: NDArray[np.bool_]
+    """Whether the hands came within `reach_radius` of the target in each test episode."""
 
     def value(self, z: Any, trial: int = 0) -> NDArray[np.float64]:
         """V(z) of trial `trial` at latent points `z` (M, 2)."""
@@ -123,8 +130,7 @@ def train_latent_policy(
         raise ValueError(f"start_demo={chosen.start_demo} is not a row of the model's {len(model.X_train_)} postures")
     low, high = latent_box(model.Z_, chosen.latent_margin)
     built = Setup(learners={"latent": chosen_task.learner(chosen, model, low, high)})
-    total = chosen.trials * (chosen.episodes + chosen.test_episodes)
-    with tqdm(total=total, unit="ep", desc="episodes", disable=not progress) as bar:
+    with tqdm(total=chosen.trials * episodes_per_trial(chosen), unit="ep", desc="episodes", disable=not progress) as bar:
         *_, result = next(iter(run_in_process(built, [("latent", 0, chosen.trials)], bar.update)))
     return LatentPolicy(
         task=task,
@@ -135,4 +141,7 @@ def train_latent_policy(
         returns=np.asarray(result["returns"]),
         ends=np.asarray(result["ends"]),
         reached=np.asarray(result["reached"]),
+        test_returns=np.asarray(result["test_returns"]),
+        test_ends=np.asarray(result["test_ends"]),
+        test_reached=np.asarray(result["test_reached"]),
     )

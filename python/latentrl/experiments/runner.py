@@ -96,6 +96,12 @@ Execute = Callable[
 ]
 
 
+def episodes_per_trial(preset: Any) -> int:
+    """Episodes a trial of `preset` reports progress for: the training and the frozen test
+    episodes (the native calls count both)."""
+    return int(preset.episodes + getattr(preset, "test_episodes", 0))
+
+
 def run_in_process(
     built: Setup, chunks: list[tuple[str, int, int]], advance: Callable[[int], object]
 ) -> Iterator[tuple[str, int, int, dict[str, Any]]]:
@@ -143,8 +149,7 @@ def run_rl(
         for t in range(preset.trials)
         if arrays[array_key(name, "ends")][t, 0] < 0
     ]
-    per_trial = preset.episodes + getattr(preset, "test_episodes", 0)  # the native calls count both
-    bar = tqdm(total=len(todo) * per_trial, unit="ep", disable=not progress, desc="episodes")
+    bar = tqdm(total=len(todo) * episodes_per_trial(preset), unit="ep", disable=not progress, desc="episodes")
     meta.setdefault("trials", {})
     try:
         for name, first, n, result in execute(built, _chunks(todo, chunk), bar.update):
