@@ -90,6 +90,13 @@ def check_finite(name: str, array: NDArray[np.float64]) -> None:
         raise ValueError(f"{name}: non-finite value {value} at index {index}")
 
 
+def int_at_least(name: str, value: Any, minimum: int = 1) -> int:
+    """`value` as an int if it is an integer (not a bool) >= `minimum`, else a ValueError."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"{name} must be an int >= {minimum}, got {value!r}")
+    return int(value)
+
+
 def positive(name: str, value: float) -> float:
     """`value` if it is a finite number > 0, else a ValueError."""
     if not (isinstance(value, (int, float, np.integer, np.floating)) and np.isfinite(value) and value > 0):

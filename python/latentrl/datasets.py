@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl._native import arms_ik
-from latentrl._validation import as_matrix
+from latentrl._validation import as_matrix, int_at_least
 
 OFFSET = np.array([0.1, 0.0])
 """The constraint: hand_R − hand_L (metres), SPEC §4.1."""
@@ -43,12 +43,6 @@ ARM_REACH = (0.1, 0.55)
 
 ARM_Y_MIN = 0.05
 """Default lowest hand height (metres) for joint-space demos: hands in front of the body."""
-
-
-def _check_n(n: int) -> int:
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"n must be an int >= 1, got {n!r}")
-    return int(n)
 
 
 def _check_noise(noise: float) -> float:
@@ -74,7 +68,7 @@ def bimanual_pairs(
     that standard deviation (metres) to every coordinate afterwards (a "slightly noisy"
     demonstrator, SPEC §4.2).
     """
-    n = _check_n(n)
+    n = int_at_least("n", n)
     noise = _check_noise(noise)
     low, high = np.asarray(left_box[0], dtype=float), np.asarray(left_box[1], dtype=float)
     if low.shape != (2,) or high.shape != (2,) or not np.all(high > low):
@@ -100,7 +94,7 @@ def arm_hands(
     The left hand is uniform over the region where both shoulder→hand distances lie in
     `reach` and both hands have y ≥ `y_min` (rejection sampling from its bounding box).
     """
-    n = _check_n(n)
+    n = int_at_least("n", n)
     r_min, r_max = float(reach[0]), float(reach[1])
     if not (0 <= r_min < r_max <= sum(LINKS) and abs(LINKS[0] - LINKS[1]) <= r_max):
         raise ValueError(f"reach must satisfy 0 <= min < max <= {sum(LINKS)}, got {reach!r}")

@@ -10,7 +10,7 @@ from numpy.typing import NDArray
 
 from latentrl._base import Estimator, SavedSpec, column_names, initial_log_theta, minimise_nll
 from latentrl._native import GpMap
-from latentrl._validation import as_matrix, positive
+from latentrl._validation import as_matrix, int_at_least, positive
 from latentrl.inverse import Projection, fit_gp_encoder
 from latentrl.pca import PCA, check_n_components
 
@@ -18,12 +18,6 @@ ENCODERS = ("gp", "projection")
 
 #: Standard deviation of the perturbation of the (unit-scaled) PCA start for each restart.
 RESTART_SCALE = 0.5
-
-
-def _check_int(name: str, value: Any, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ValueError(f"{name} must be an int >= {minimum}, got {value!r}")
-    return int(value)
 
 
 class GPLVM(Estimator):
@@ -151,8 +145,8 @@ class GPLVM(Estimator):
         names = column_names(X)
         X = as_matrix("X", X)
         check_n_components(self.n_components, X)
-        max_iter = _check_int("max_iter", self.max_iter, 1)
-        n_restarts = _check_int("n_restarts", self.n_restarts, 0)
+        max_iter = int_at_least("max_iter", self.max_iter, 1)
+        n_restarts = int_at_least("n_restarts", self.n_restarts, 0)
         noise_floor = positive("noise_floor", self.noise_floor)
         tol = positive("tol", self.tol)
         self._check_encoder(self.encoder)

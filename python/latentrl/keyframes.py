@@ -10,13 +10,8 @@ from typing import Any
 import numpy as np
 
 from latentrl._native import Sim
+from latentrl._validation import int_at_least
 from latentrl.demos import Demonstrations
-
-
-def _positive_int(name: str, value: Any) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise ValueError(f"{name} must be an int >= 1, got {value!r}")
-    return int(value)
 
 
 def interpolate_keyframes(keyframes: Demonstrations, per_segment: int, *, breaks: Sequence[int] = ()) -> Demonstrations:
@@ -25,7 +20,7 @@ def interpolate_keyframes(keyframes: Demonstrations, per_segment: int, *, breaks
     sequence ending on its last keyframe. `breaks` are the rows that start a new sequence
     (another style), so no line joins row `b − 1` to row `b`: the shipped lift demos are two
     sequences, `breaks=(4,)`."""
-    steps = _positive_int("per_segment", per_segment)
+    steps = int_at_least("per_segment", per_segment)
     frames = keyframes.postures
     cuts = sorted({int(b) for b in breaks})
     if any(not 0 < b < len(frames) for b in cuts):
@@ -51,7 +46,7 @@ def record_postures(sim: Sim, targets: Any, *, hold_steps: int, every: int = 1) 
         raise ValueError(f"targets must have shape (M >= 1, {len(names)}), got {goal.shape}")
     if not np.isfinite(goal).all():
         raise ValueError("targets must be finite")
-    hold, stride = _positive_int("hold_steps", hold_steps), _positive_int("every", every)
+    hold, stride = int_at_least("hold_steps", hold_steps), int_at_least("every", every)
     if stride > hold:
         raise ValueError(f"every ({stride}) must be at most hold_steps ({hold})")
     recorded = []

@@ -8,17 +8,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl._base import Estimator, SavedSpec, column_names
-from latentrl._validation import as_matrix
+from latentrl._validation import as_matrix, int_at_least
 
 
 def check_n_components(n_components: Any, X: NDArray[np.float64]) -> int:
     """`n_components` if it is an int with `n_components < n_samples` and `≤ n_features`."""
-    if (
-        isinstance(n_components, bool)
-        or not isinstance(n_components, (int, np.integer))
-        or n_components < 1
-    ):
-        raise ValueError(f"n_components must be an int >= 1, got {n_components!r}")
+    n_components = int_at_least("n_components", n_components)
     n_samples, n_features = X.shape
     if n_samples <= n_components:
         raise ValueError(

@@ -11,6 +11,8 @@ from typing import Any
 
 import numpy as np
 
+from latentrl._validation import int_at_least
+
 
 @cache
 def field_docs(preset_cls: type) -> dict[str, str]:
@@ -45,9 +47,7 @@ def latent_box(latent: np.ndarray, margin: float) -> tuple[np.ndarray, np.ndarra
 def check_ints(preset: Any, names: tuple[str, ...], minimum: int = 1) -> None:
     """ValueError naming the first of `names` that is not an int >= `minimum`."""
     for name in names:
-        value = getattr(preset, name)
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-            raise ValueError(f"{name} must be an int >= {minimum}, got {value!r}")
+        int_at_least(name, getattr(preset, name), minimum)
 
 
 def check_floats(preset: Any, names: tuple[str, ...], *, positive: bool) -> None:
