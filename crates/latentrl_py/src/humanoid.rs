@@ -1,7 +1,7 @@
 //! Binding of `sim::humanoid`: the fall check of the floating humanoid in one call.
 
-use ::sim::humanoid::{FallCheckConfig, run_fall_check_observed};
-use ::sim::{PdGains, PhysicsSim, RootMode, SimOptions};
+use ::sim::humanoid::{FallCheckConfig, run_fall_check_observed, sim_options};
+use ::sim::{PdGains, PhysicsSim, SimOptions};
 use nalgebra::DMatrix;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -66,13 +66,11 @@ pub fn humanoid_fall_check<'py>(
         let rows: Vec<Vec<f64>> = targets.column_iter().map(|c| c.iter().copied().collect()).collect();
         let gains = PdGains::new(kp, kd, max_force).map_err(sim_to_py)?;
         let options = SimOptions {
-            root: RootMode::Floating,
-            ground: Some(0.0),
             gains,
             dt,
             solver_iterations,
             pgs_iterations,
-            ..SimOptions::default()
+            ..sim_options()
         };
         let config = FallCheckConfig {
             hold,
