@@ -14,6 +14,7 @@ from latentrl._native import GpMap, InvalidInputError, run_arms_trials
 from latentrl.experiments import exp2
 from latentrl.experiments.exp2 import Exp2Preset, run_exp2
 from latentrl.experiments.results import write_npz
+from learning import assert_separated, control
 
 TINY = dataclasses.replace(Exp2Preset.quick(), trials=2, episodes=6, steps=60, test_episodes=3)
 
@@ -126,19 +127,39 @@ def quick_run(tmp_path_factory):
     return out, meta
 
 
-def test_quick_preset_passes_the_corridor_and_reaches_the_target(quick_run):
-    """SPEC §4.2 quick preset: success ≥ 60 %, return ratio ≥ 1.4 and ≥ 600, corridor endings
-    in episodes 201–300 ≤ 20 % (kinematic study: success 84–90 %, ratio 1.8–2.8)."""
+@pytest.fixture(scope="module")
+def control_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("exp2_control")
+    run_exp2(control(Exp2Preset.quick()), out, progress=False)
+    return out
+
+
+def test_quick_preset_passes_the_corridor_and_reaches_the_target(quick_run, control_run):
+    """SPEC §4.2's quick-preset thresholds, each met by the learner and missed by the control
+    (α = 1e-12) on the same trials: return of episodes 251–300 ≥ 600, test success ≥ 60 %,
+    corridor passed in ≥ 60 % of the tests, corridor endings in episodes 201–300 ≤ 20 %.
+    Calibrated on 10 trials of seed 0 (AMD EPYC, `latentrl sweep`, grid alpha = [0.8, 1e-12]):
+    late return learner 820–916, control 21–47; test success 0.84–0.96 vs 0–0.04; corridor
+    endings in the last 50 episodes 0–6 % vs 38–52 %. SPEC's return ratio ≥ 1.4 is not asserted:
+    the control reaches 1.9 (its returns are small and noisy)."""
     out, meta = quick_run
+    arrays = {}
+    for name, where in (("learner", out), ("control", control_run)):
+        with np.load(where / "returns.npz") as npz:
+            returns, ends = npz["latent"], npz["latent_end"]
+            arrays[name] = {
+                "late return": returns[:, 250:].mean(axis=1),
+                "test success": npz["latent_test_reached"].mean(axis=1),
+                "tests passing the corridor": npz["latent_test_passed"].mean(axis=1),
+                "corridor endings, episodes 201-300": (ends[:, 200:] == 1).mean(axis=1),
+            }
+    learner, ctrl = arrays["learner"], arrays["control"]
+    for what, threshold in (("late return", 600), ("test success", 0.6), ("tests passing the corridor", 0.6)):
+        assert_separated(learner[what], ctrl[what], threshold, what)
+    what = "corridor endings, episodes 201-300"
+    assert_separated(-learner[what], -ctrl[what], -0.2, what + " (negated: the learner below 20 %)")
     with np.load(out / "returns.npz") as npz:
-        returns, ends = npz["latent"], npz["latent_end"]
         success, passed = npz["latent_test_reached"], npz["latent_test_passed"]
-    first, last = returns[:, :50].mean(axis=1), returns[:, 250:].mean(axis=1)
-    assert np.all(last >= 1.4 * first), (first, last)
-    assert np.all(last >= 600), last
-    assert np.all((ends[:, 200:] == 1).mean(axis=1) <= 0.2)
-    assert np.all(success.mean(axis=1) >= 0.6), success.mean(axis=1)
-    assert np.all(passed.mean(axis=1) >= 0.6), passed.mean(axis=1)
     for t, summary in meta["trials"]["latent"].items():
         assert summary["test_success"] == success[int(t)].mean()
         assert summary["test_passed"] == passed[int(t)].mean()

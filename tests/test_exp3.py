@@ -15,6 +15,7 @@ from latentrl._native import InvalidInputError, run_lift_trials
 from latentrl.experiments import exp3, exp3_figures
 from latentrl.experiments.exp3 import Exp3Preset, run_exp3
 from latentrl.experiments.results import write_npz
+from learning import assert_separated, control
 
 TINY = dataclasses.replace(Exp3Preset.quick(), trials=2, episodes=3, steps=8, test_episodes=1, map_grid=8)
 
@@ -122,15 +123,25 @@ def test_quick_preset_ends_episodes_correctly(quick_run):
         assert sum(summary["ends"].values()) == preset.episodes
 
 
-def test_quick_preset_learns(quick_run):
-    """Both trials return more and reach h* more often in their last 50 episodes than in their
-    first 50 (measured: return 45 → 73 and 36 → 57, reached 52 → 66 % and 28 → 64 %)."""
-    out, _ = quick_run
-    with np.load(out / "returns.npz") as npz:
-        returns, reached = npz["latent"], npz["latent_reached"]
-    early, late = returns[:, :50].mean(axis=1), returns[:, -50:].mean(axis=1)
-    assert np.all(late > early + 10), (early, late)
-    assert reached[:, -50:].mean() > reached[:, :50].mean() + 0.1
+@pytest.fixture(scope="module")
+def control_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("exp3_control")
+    run_exp3(control(Exp3Preset.quick()), out, progress=False)
+    return out
+
+
+def test_quick_preset_learns(quick_run, control_run):
+    """The mean return of the last 50 episodes lies above 52 for the learner and below it for the
+    control (α = 1e-12) on the same trials. Calibrated on 10 trials of seed 0 (AMD EPYC,
+    `latentrl sweep`, quick preset, grid alpha = [0.8, 1e-12]): learner 63.3–78.5, control
+    28.1–42.1. Neither the gain over the first 50 episodes (learner 4.3–28.3, control −5.6–9.7)
+    nor the reach rate (last 50: learner 0.04–0.38, control 0.14–0.20) separates the two at this
+    budget, so neither is asserted."""
+    late = {}
+    for name, out in (("learner", quick_run[0]), ("control", control_run)):
+        with np.load(out / "returns.npz") as npz:
+            late[name] = npz["latent"][:, -50:].mean(axis=1)
+    assert_separated(late["learner"], late["control"], 52.0, "mean return of the last 50 episodes")
 
 
 def test_results_layout_follows_spec(quick_run):

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from latentrl._native import GpMap, InvalidInputError, run_bimanual_trials
+from learning import CONTROL_ALPHA, assert_separated
 
 LOW = np.array([-0.4, -0.4])
 HIGH = np.array([1.3, 1.3])
@@ -98,18 +99,24 @@ def test_same_seed_same_arrays_and_shapes():
     assert a["config"]["alpha"] == 0.9 and a["config"]["max_steps"] == 20
 
 
-def test_full_space_learner_improves_with_forgiving_tolerance():
+def test_full_space_learner_learns_with_forgiving_tolerance():
+    """Mean return of the last 50 of 300 episodes above 1.8 for the full-space learner, below it
+    for the control (α = 1e-12, same trials). Calibrated on 20 trials of seed 1 (AMD EPYC):
+    learner 2.20–5.82, control 0.59–1.53; the last/first ratio (learner 2.0–5.5, control
+    0.5–1.7) separates too, with less room."""
     calls = []
-    out = run_bimanual_trials(
-        "full",
-        n_trials=2,
-        episodes=300,
-        base_seed=1,
-        config={"drop_tolerance": 0.1, "max_steps": 200},
-        progress=lambda done, total: calls.append((done, total)),
-    )
-    r = out["returns"]
-    assert np.all(r[:, 250:].mean(axis=1) > r[:, :50].mean(axis=1)), r.mean(axis=0)
+    late = {}
+    for name, alpha in (("learner", 0.9), ("control", CONTROL_ALPHA)):
+        out = run_bimanual_trials(
+            "full",
+            n_trials=2,
+            episodes=300,
+            base_seed=1,
+            config={"drop_tolerance": 0.1, "max_steps": 200, "alpha": alpha},
+            progress=lambda done, total: calls.append((done, total)),
+        )
+        late[name] = out["returns"][:, -50:].mean(axis=1)
+    assert_separated(late["learner"], late["control"], 1.8, "full-space return of the last 50 episodes")
     assert calls and calls[-1] == (600, 600)
 
 

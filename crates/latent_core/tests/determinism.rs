@@ -1,41 +1,78 @@
-//! Trials give bitwise the same results on 1 and 2 threads, and for the same seed
-//! (STYLE: "a test compares 1 and N threads bitwise").
-
-mod common;
+//! Trials give bitwise the same results on 1 and 2 threads, and a trial the same alone or
+//! among others (STYLE: "a test compares 1 and N threads bitwise"), on a toy plant: a point
+//! on a line that earns its position and ends beyond 0.9.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use latent_core::{LearnerConfig, TrialOptions, TrialResult};
-use sim::bimanual::{BimanualConfig, BimanualLearner, run_bimanual_trials};
+use latent_core::episode::StepOutcome;
+use latent_core::{
+    EndReason, Learner, LearnerConfig, Plant, RbfConfig, StartMode, StateSpace, TrialOptions, TrialResult,
+    orthogonal_actions, run_trials,
+};
+use rand::{Rng, RngExt};
+
+struct Line {
+    x: f64,
+}
+
+impl Plant for Line {
+    fn posture_dim(&self) -> usize {
+        1
+    }
+    fn task_dim(&self) -> usize {
+        1
+    }
+    fn sample_start<R: Rng + ?Sized>(&mut self, rng: &mut R, posture: &mut [f64]) {
+        posture[0] = rng.random_range(0.0..0.5);
+    }
+    fn reset(&mut self, posture: &[f64]) -> Option<EndReason> {
+        self.x = posture[0];
+        None
+    }
+    fn step(&mut self, target: &[f64], reached: &mut [f64]) -> StepOutcome {
+        self.x = target[0];
+        reached[0] = self.x;
+        let end = (self.x > 0.9).then_some(EndReason::Obstacle);
+        StepOutcome {
+            reward: self.x - if end.is_some() { 1.0 } else { 0.0 },
+            end,
+        }
+    }
+    fn task_position(&self, out: &mut [f64]) {
+        out[0] = self.x;
+    }
+}
 
 fn options() -> TrialOptions {
     TrialOptions {
         n_trials: 4,
-        episodes: 25,
+        episodes: 40,
         base_seed: 42,
-        record_episodes: vec![0, 24],
+        record_episodes: vec![0, 39],
         keep_weights: true,
         ..Default::default()
     }
 }
 
-fn config() -> LearnerConfig {
-    LearnerConfig {
-        max_steps: 80,
-        step_fraction: 0.5,
+fn run_on(threads: usize, options: &TrialOptions) -> Vec<TrialResult> {
+    let config = LearnerConfig {
+        rbf: RbfConfig {
+            centres_per_dim: 11,
+            ..RbfConfig::default()
+        },
+        max_steps: 50,
+        start: StartMode::FromPlant,
         ..LearnerConfig::default()
-    }
-}
-
-fn run_on(threads: usize, learner: &BimanualLearner<'_>, options: &TrialOptions) -> Vec<TrialResult> {
+    };
+    let learner = Learner::new(&config, &[0.0], &[1.0], &orthogonal_actions(1)).unwrap();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let done = AtomicUsize::new(0);
     let results = pool
         .install(|| {
-            run_bimanual_trials(
-                &BimanualConfig::default(),
-                &config(),
-                learner,
+            run_trials(
+                &learner,
+                &StateSpace::Full,
+                |_| Ok(Line { x: 0.0 }),
                 options,
                 &AtomicBool::new(false),
                 &done,
@@ -46,18 +83,17 @@ fn run_on(threads: usize, learner: &BimanualLearner<'_>, options: &TrialOptions)
     results
 }
 
-/// Bitwise equality, f64 by bit pattern.
+fn bits(v: &[f64]) -> Vec<u64> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
 fn assert_bitwise_equal(a: &[TrialResult], b: &[TrialResult]) {
     assert_eq!(a.len(), b.len());
     for (x, y) in a.iter().zip(b) {
-        assert_eq!(x.trial, y.trial);
-        assert_eq!(x.finished, y.finished);
-        assert_eq!(x.episodes.len(), y.episodes.len());
-        for (e, f) in x.episodes.iter().zip(&y.episodes) {
-            assert_eq!(e.ret.to_bits(), f.ret.to_bits());
-            assert_eq!((e.end, e.steps, e.reached), (f.end, f.steps, f.reached));
-        }
-        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!((x.trial, x.finished), (y.trial, y.finished));
+        let returns = |t: &TrialResult| t.episodes.iter().map(|e| e.ret).collect::<Vec<_>>();
+        assert_eq!(bits(&returns(x)), bits(&returns(y)));
+        assert_eq!(x.episodes, y.episodes);
         for (t, u) in x.trajectories.iter().zip(&y.trajectories) {
             assert_eq!(bits(t), bits(u));
         }
@@ -66,53 +102,20 @@ fn assert_bitwise_equal(a: &[TrialResult], b: &[TrialResult]) {
 }
 
 #[test]
-fn full_space_one_vs_two_threads() {
-    let a = run_on(1, &BimanualLearner::Full, &options());
-    let b = run_on(2, &BimanualLearner::Full, &options());
+fn one_vs_two_threads() {
+    let a = run_on(1, &options());
+    let b = run_on(2, &options());
     assert_bitwise_equal(&a, &b);
-    // Trials differ from each other (own streams).
-    assert_ne!(a[0].episodes, a[1].episodes);
+    assert_ne!(a[0].episodes, a[1].episodes, "trials draw from their own streams");
 }
 
 #[test]
-fn latent_one_vs_two_threads() {
-    let (decoder, encoder) = common::synthetic_maps();
-    let learner = common::latent_learner(&decoder, &encoder);
-    let a = run_on(1, &learner, &options());
-    let b = run_on(2, &learner, &options());
-    assert_bitwise_equal(&a, &b);
-    assert!(
-        a.iter()
-            .flat_map(|t| &t.episodes)
-            .all(|e| e.end != latent_core::EndReason::Drop)
-    );
-}
-
-#[test]
-fn a_trial_is_the_same_alone_or_in_a_sweep() {
-    let all = run_on(2, &BimanualLearner::Full, &options());
+fn a_trial_is_the_same_alone_or_among_others() {
+    let all = run_on(2, &options());
     let third = TrialOptions {
         n_trials: 1,
         first_trial: 2,
         ..options()
     };
-    let alone = run_on(1, &BimanualLearner::Full, &third);
-    assert_bitwise_equal(&all[2..3], &alone);
-}
-
-#[test]
-fn cancel_stops_every_trial_unfinished() {
-    let cancel = AtomicBool::new(true);
-    let done = AtomicUsize::new(0);
-    let r = run_bimanual_trials(
-        &BimanualConfig::default(),
-        &config(),
-        &BimanualLearner::Full,
-        &options(),
-        &cancel,
-        &done,
-    )
-    .unwrap();
-    assert!(r.iter().all(|t| !t.finished && t.episodes.is_empty()));
-    assert_eq!(done.load(Ordering::Relaxed), 0);
+    assert_bitwise_equal(&all[2..3], &run_on(1, &third));
 }
