@@ -70,7 +70,7 @@ install-check: ## `pip install .` into a fresh venv as a user would, then use th
 	cd $(INSTALL_VENV) && bin/python -c "import importlib.util, sys; sys.exit(importlib.util.find_spec('matplotlib') is not None)"
 	cd $(INSTALL_VENV) && bin/python $(CURDIR)/tests/core_without_matplotlib.py
 	$(INSTALL_VENV)/bin/python -m pip install --quiet "latentrl[plot]"
-	cd $(INSTALL_VENV) && bin/latentrl run exp2 --quick --no-progress --trials 1 --episodes 2 --steps 10 \
+	cd $(INSTALL_VENV) && bin/latentrl run exp2 --quick --no-progress --trials 1 --episodes 2 --episode.max-steps 10 \
 		--test-episodes 1 --fig5-samples 50 --gplvm-max-iter 20 --out run
 	cd $(INSTALL_VENV) && test -s run/results.json && test -s run/fig6a.png && echo "install-check: pip install . works"
 

@@ -18,8 +18,8 @@ MuJoCo's `mj_step` runs on the calling thread):
   demonstrated posture (`latentrl.datasets.arm_postures`, seed 0). No contacts (the arms' links
   do not collide with each other in either simulation).
 - humanoid: `khr1hv.urdf`, floating root on a floor plane, gravity, dt 1/240 s, servos kp 8,
-  kd 0.1, torque cap ±1.2 N·m (`latentrl.humanoid.SERVO`); rapier at 1 solver iteration of 4
-  PGS passes (`latentrl.humanoid.PHYSICS`) and at rapier's default, 4 iterations of 1. Stands at its home posture (every joint 0,
+  kd 0.1, torque cap ±1.2 N·m (`[servo]` of the shipped `humanoid_lift` task); rapier at 1 solver
+  iteration of 4 PGS passes (its `[physics]`) and at rapier's default, 4 iterations of 1. Stands at its home posture (every joint 0,
   the posture the Rust stand test holds for 10 s), soles 0.5 mm above the floor at the start.
   Only robot–floor contacts (no self-collisions in either simulation); friction 0.5 (rapier's
   default) on every shape in both.
@@ -58,10 +58,9 @@ from typing import Any
 import numpy as np
 
 import latentrl
-from latentrl import humanoid
 from latentrl._native import Sim
 from latentrl.datasets import arm_postures
-from latentrl.envs import arms_urdf
+from latentrl.task import Task
 from latentrl.experiments.results import write_json
 
 try:
@@ -74,10 +73,10 @@ DT = 1.0 / 240.0
 SUBSTEPS = 12
 ARMS = {"kp": 5000.0, "kd": 50.0, "max_force": 1000.0}  # cap = two_arms.urdf effort
 ARMS_ITERATIONS = (2, 4)  # Exp 2 uses 2; rapier's default is 4
-# (solver iterations, PGS passes): latentrl.humanoid.PHYSICS, and rapier's default
+# (solver iterations, PGS passes): the humanoid_lift task's [physics], and rapier's default
 HUMANOID_PHYSICS = ((1, 4), (4, 1))
 FRICTION = 0.5  # rapier's default collider friction, used in MuJoCo too
-CLEARANCE = 5e-4  # soles above the floor at the start, as sim::humanoid::reset_on_ground
+CLEARANCE = 5e-4  # soles above the floor at the start (Sim.reset_on_ground)
 STEP = 0.1  # rad, the tracking check's target step on every arm joint
 STANDING = 0.9  # the humanoid stands while its base height keeps this fraction of the start
 REPEATS = 5  # timed loops per row (median and best reported), after one warm-up loop
@@ -102,25 +101,20 @@ class RapierRobot:
         iterations: int,
         pgs_iterations: int = 1,
         floor: float | None = None,
-        base_link: str | None = None,
+        sole: str | None = None,
     ) -> None:
-        self.sim = Sim(
-            urdf,
-            root="floating" if floating else "fixed",
-            dt=DT,
-            substeps=SUBSTEPS,
-            solver_iterations=iterations,
-            pgs_iterations=pgs_iterations,
-            ground=floor,
-            **gains,
-        )
+        physics = {"dt": DT, "substeps": SUBSTEPS, "solver_iterations": iterations, "pgs_iterations": pgs_iterations}
+        self.sim = Sim(urdf, root="floating" if floating else "fixed", floor=floor, physics=physics, servo=gains)
         self.floor = 0.0 if floor is None else floor
         self.floating = floating
-        self.base_link = base_link
+        self.sole = sole
         self.joint_names = self.sim.joint_names
 
     def reset(self, posture: np.ndarray) -> None:
-        self.sim.reset(posture)
+        if self.sole is None:
+            self.sim.reset(posture)
+        else:
+            self.sim.reset_on_ground(posture, self.sole, CLEARANCE)
 
     def set_targets(self, targets: np.ndarray) -> None:
         self.sim.set_targets(targets)
@@ -135,12 +129,10 @@ class RapierRobot:
         return self.sim.joint_velocities()
 
     def base_height(self) -> float:
-        assert self.base_link is not None
-        return float(self.sim.frame_position(self.base_link)[2] - self.floor)
+        return float(self.sim.base_position()[2] - self.floor)
 
     def base_xy(self) -> np.ndarray:
-        assert self.base_link is not None
-        return self.sim.frame_position(self.base_link)[:2].copy()
+        return self.sim.base_position()[:2].copy()
 
 
 class MujocoRobot:
@@ -370,7 +362,7 @@ def step_response(robot: Any, posture: np.ndarray, steps: int) -> np.ndarray:
 
 
 def arms_case(*, quick: bool) -> dict[str, Any]:
-    urdf = Path(arms_urdf())
+    urdf = Task.shipped("two_arms").urdf_path
     posture = arm_postures(1, np.random.default_rng(0))[0]
     steps, rl_steps = (1200, 100) if quick else (12000, 1000)
     robots: dict[str, Any] = {
@@ -410,22 +402,24 @@ def arms_case(*, quick: bool) -> dict[str, Any]:
 
 
 def humanoid_case(*, quick: bool) -> dict[str, Any]:
-    urdf = humanoid.urdf_path()
-    kin = humanoid.model()
-    posture = np.zeros(len(kin.joint_names))  # home: every joint 0, within all limits
-    poses = kin.link_poses(posture)  # base (torso) at the identity, as Sim.reset leaves it
-    lowest = min(c[2] for s in ("l_foot", "r_foot") for c in kin.sole_corners(poses, s))
-    start_height = CLEARANCE - lowest  # base above the floor
+    task = Task.shipped("humanoid_lift")
+    urdf, servo = task.urdf_path, task.to_dict()["servo"]
+    children = {child for _, child in task.edges}
+    root = next(parent for parent, _ in task.edges if parent not in children)
+    posture = np.zeros(len(task.joint_names))  # home: every joint 0, within all limits
+    probe = RapierRobot(urdf, floating=True, gains=servo, iterations=1, floor=0.0, sole="l_foot")
+    probe.reset(posture)
+    start_height = probe.base_height()  # base above the floor, soles CLEARANCE above it
     steps = 240 if quick else 2400
     robots: dict[str, Any] = {
         f"rapier_it{it}_pgs{pgs}": RapierRobot(
             urdf,
             floating=True,
-            gains=humanoid.SERVO,
+            gains=servo,
             iterations=it,
             pgs_iterations=pgs,
-            floor=lowest - CLEARANCE,
-            base_link=kin.root,
+            floor=0.0,
+            sole="l_foot",
         )
         for it, pgs in HUMANOID_PHYSICS
     }
@@ -434,9 +428,9 @@ def humanoid_case(*, quick: bool) -> dict[str, Any]:
         robots[f"mujoco_{integrator}"] = MujocoRobot(
             urdf,
             names,
-            gains=humanoid.SERVO,
+            gains=servo,
             integrator=integrator,
-            floating_body=kin.root,
+            floating_body=root,
             floor=True,
             start_height=start_height,
         )
@@ -575,7 +569,7 @@ def main(argv: list[str] | None = None) -> int:
             "substeps_per_rl_step": SUBSTEPS,
             "arms_gains": ARMS,
             "arms_rapier_solver_iterations": list(ARMS_ITERATIONS),
-            "humanoid_gains": humanoid.SERVO,
+            "humanoid_gains": Task.shipped("humanoid_lift").to_dict()["servo"],
             "humanoid_rapier_solver_iterations_pgs_passes": [list(p) for p in HUMANOID_PHYSICS],
             "friction": FRICTION,
             "mujoco": "MjSpec.from_file(urdf); position actuators kp, kv=kd, forcerange=cap, "

@@ -26,50 +26,51 @@ import numpy as np  # noqa: E402
 from latentrl import GPLVM, _native  # noqa: E402
 from latentrl._reference import rbf_centres, rbf_features, td0_update  # noqa: E402
 from latentrl.datasets import bimanual_pairs  # noqa: E402
-from latentrl.experiments.exp1 import Exp1Preset, OBSTACLE_CENTRE, TARGET, native_config  # noqa: E402
+from latentrl.experiments.exp1 import Exp1Preset, configs  # noqa: E402
 from latentrl.experiments.presets import latent_box  # noqa: E402
 from latentrl.experiments.results import environment, write_json  # noqa: E402
 
 
 def numpy_loop(model: GPLVM, preset: Exp1Preset, low, high, steps: int, seed: int) -> float:
     """Steps per second of the plain NumPy latent loop (episodes restart on termination)."""
+    plant, learner = configs(preset)
     rng = np.random.default_rng(seed)
-    centres, spacing = rbf_centres(low, high, preset.rbf_per_dim)
-    sigma = spacing
-    weights = np.full(len(centres), preset.initial_weight)
-    actions = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]]) * preset.step_fraction * spacing
-    dec_in, dec_out, dec_theta = model.Z_, model.X_train_, model.theta_
-    enc_in, enc_out, enc_theta = model.X_train_, model.Z_, model.encoder_theta_
-    dec = _gp_mean_factory(dec_in, dec_out, dec_theta)
-    enc = _gp_mean_factory(enc_in, enc_out, enc_theta)
+    centres, spacing = rbf_centres(low, high, learner["rbf_per_dim"])
+    sigma = spacing * learner["rbf_width"]
+    weights = np.full(len(centres), learner["initial_weight"])
+    actions = np.array([[1, 0], [-1, 0], [0, 1], [0, -1]]) * learner["step"] * spacing
+    grip, centre, target = (np.asarray(plant[k]) for k in ("grip", "obstacle_centre", "target"))
+    dec = _gp_mean_factory(model.Z_, model.X_train_, model.theta_)
+    enc = _gp_mean_factory(model.X_train_, model.Z_, model.encoder_theta_)
+    alpha, gamma = learner["alpha"], learner["gamma"]
 
     def start():
-        left = np.array([1.0, 1.0]) + preset.start_std * rng.standard_normal(2)
-        return enc(np.concatenate([left, left + [0.1, 0.0]]))
+        left = np.asarray(plant["start_mean"]) + plant["start_sd"] * rng.standard_normal(2)
+        return enc(np.concatenate([left, left + grip]))
 
     z, t = start(), 0
     begin = time.perf_counter()
     for _ in range(steps):
         b = rbf_features(z, centres, sigma)
         q = np.array([weights @ rbf_features(z + a, centres, sigma) for a in actions])
-        p = np.exp(preset.beta * (q - q.max()))
+        p = np.exp(learner["beta"] * (q - q.max()))
         u = actions[rng.choice(len(actions), p=p / p.sum())]
-        target = z + u
-        hands = dec(target)
-        dropped = np.linalg.norm(hands[2:] - hands[:2] - [0.1, 0.0]) > preset.drop_tolerance
-        hit = min(np.linalg.norm(hands[:2] - OBSTACLE_CENTRE), np.linalg.norm(hands[2:] - OBSTACLE_CENTRE)) < preset.obstacle_radius
-        outside = np.any(target < low) or np.any(target > high)
-        reward = np.exp(-preset.reward_theta * np.sum((hands - TARGET) ** 2))
+        goal = z + u
+        hands = dec(goal)
+        dropped = np.linalg.norm(hands[2:] - hands[:2] - grip) > plant["drop_tolerance"]
+        hit = min(np.linalg.norm(hands[:2] - centre), np.linalg.norm(hands[2:] - centre)) < plant["obstacle_radius"]
+        outside = np.any(goal < low) or np.any(goal > high)
+        reward = np.exp(-plant["theta"] * np.sum((hands - target) ** 2))
         z_next = enc(hands)
         t += 1
         if dropped or hit or outside:
-            td0_update(weights, b, reward - 1.0, 0.0, preset.alpha, preset.gamma)
+            td0_update(weights, b, reward + plant["penalty"], 0.0, alpha, gamma)
             z, t = start(), 0
             continue
         v_next = weights @ rbf_features(z_next, centres, sigma)
-        td0_update(weights, b, reward, v_next, preset.alpha, preset.gamma)
+        td0_update(weights, b, reward, v_next, alpha, gamma)
         z = z_next
-        if t >= preset.steps:
+        if t >= plant["max_steps"]:
             z, t = start(), 0
     return steps / (time.perf_counter() - begin)
 
@@ -90,8 +91,9 @@ def _gp_mean_factory(inputs, outputs, theta):
 def rust_loop(model: GPLVM, preset: Exp1Preset, low, high, episodes: int, seed: int) -> float:
     """Steps per second of latentrl's latent loop (one trial)."""
     begin = time.perf_counter()
+    plant, learner = configs(preset)
     out = _native.run_bimanual_trials(
-        "latent", n_trials=1, episodes=episodes, base_seed=seed, config=native_config(preset),
+        n_trials=1, episodes=episodes, base_seed=seed, plant=plant, learner=learner,
         decoder=model.decoder_, encoder=model.encoder_, latent_low=low, latent_high=high,
     )
     return float(out["steps"].sum()) / (time.perf_counter() - begin)

@@ -6,7 +6,8 @@
 import argparse
 from pathlib import Path
 
-from latentrl.experiments.exp1 import Exp1Preset, run_exp1
+from latentrl.experiments.exp1 import Exp1Preset
+from latentrl.experiments.registry import run_experiment
 
 
 def main() -> None:
@@ -15,7 +16,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="the 5-second smoke-test preset")
     parser.add_argument("--out", type=Path, default=Path("results/exp1"))
     args = parser.parse_args()
-    meta = run_exp1(Exp1Preset.quick() if args.quick else Exp1Preset(), args.out)
+    meta = run_experiment("exp1", Exp1Preset.quick() if args.quick else Exp1Preset(), args.out)
     for learner, trials in meta["trials"].items():
         last = [t["mean_return_last"] for t in trials.values()]
         reached = [t["reached_last"] for t in trials.values()]

@@ -7,7 +7,8 @@
 import argparse
 from pathlib import Path
 
-from latentrl.experiments.exp2 import Exp2Preset, run_exp2
+from latentrl.experiments.exp2 import Exp2Preset
+from latentrl.experiments.registry import run_experiment
 
 
 def main() -> None:
@@ -16,7 +17,7 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="the ~1.5-minute smoke-test preset")
     parser.add_argument("--out", type=Path, default=Path("results/exp2"))
     args = parser.parse_args()
-    meta = run_exp2(Exp2Preset.quick() if args.quick else Exp2Preset(), args.out)
+    meta = run_experiment("exp2", Exp2Preset.quick() if args.quick else Exp2Preset(), args.out)
     trials = meta["trials"]["latent"].values()
     last = [t["mean_return_last"] for t in trials]
     print(f"mean return of the last 10 % of episodes {sum(last) / len(last):.1f}")

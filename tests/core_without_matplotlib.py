@@ -24,14 +24,15 @@ def main() -> None:
     import numpy as np
 
     import latentrl.envs  # noqa: F401  (registers the envs)
-    from latentrl import GPLVM, Demonstrations, save_demos
+    from latentrl import GPLVM, Demonstrations, Task, save_demos
     from latentrl.cli import main as cli
     from latentrl.datasets import arm_postures
-    from latentrl.experiments.exp2 import JOINT_NAMES
     from latentrl.train import train_latent_policy
 
     model = GPLVM(n_components=2, max_iter=20, random_state=0).fit(arm_postures(30, np.random.default_rng(0)))
-    policy = train_latent_policy(model, trials=1, episodes=2, steps=10, test_episodes=0)
+    policy = train_latent_policy(
+        model, trials=1, episodes=2, test_episodes=0, overrides={"episode.max_steps": 10}
+    )
     assert policy.returns.shape == (1, 2) and np.isfinite(policy.returns).all()
     env = gym.make("latentrl/TwoArms-v0")
     env.reset(seed=0)
@@ -43,7 +44,7 @@ def main() -> None:
         assert "latentrl[plot]" in str(err), err
     with tempfile.TemporaryDirectory() as tmp:
         demos = Path(tmp) / "demos.csv"
-        save_demos(Demonstrations(arm_postures(20, np.random.default_rng(1)), JOINT_NAMES), demos)
+        save_demos(Demonstrations(arm_postures(20, np.random.default_rng(1)), Task.shipped("two_arms").joint_names), demos)
         with contextlib.redirect_stdout(io.StringIO()):
             assert cli(["fit", str(demos), "--out", str(Path(tmp) / "m.npz"), "--max-iter", "10"]) == 0
         stderr = io.StringIO()

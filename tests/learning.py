@@ -11,18 +11,19 @@ docstring (measured with `latentrl sweep`, grid `alpha = [<paper's α>, 1e-12]`,
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Any
 
 import numpy as np
+
+from latentrl.experiments.presets import with_overrides
 
 CONTROL_ALPHA = 1e-12
 """α of the non-learning control."""
 
 
 def control(preset: Any) -> Any:
-    """`preset` with the control's learning rate."""
-    return dataclasses.replace(preset, alpha=CONTROL_ALPHA)
+    """`preset` with the control's learning rate (the task key `learner.alpha`)."""
+    return with_overrides(preset, {"learner.alpha": CONTROL_ALPHA})
 
 
 def assert_separated(learner: Any, control_values: Any, threshold: float, what: str) -> None:

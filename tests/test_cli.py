@@ -34,7 +34,11 @@ def test_help_documents_every_preset_flag():
     assert all(name in text for name in ("table1", "exp1", "exp2"))
     exp1 = latentrl("run", "exp1", "--help")
     assert exp1.returncode == 0
-    assert "--drop-tolerance" in exp1.stdout and "Soft-max inverse temperature" in exp1.stdout
+    assert "--plant.drop-tolerance" in exp1.stdout and "Soft-max inverse temperature" in exp1.stdout
+    exp2 = " ".join(latentrl("run", "exp2", "--help").stdout.split())
+    # Task keys: the native doc, kind, rule and default of each.
+    assert "--learner.gamma FLOAT Discount γ; below 1" in exp2 and "must lie in [0, 1); default: 0.99)" in exp2
+    assert "--physics.dt" in exp2 and "default: 0.004166666666666667" in exp2
 
 
 @pytest.mark.parametrize("experiment", ["table1", "exp1", "exp2", "exp3"])
@@ -50,7 +54,7 @@ def test_run_exp1_tiny(tmp_path):
     out = tmp_path / "run"
     result = latentrl(
         "run", "exp1", "--quick", "--no-progress", "--trials", "1", "--episodes", "5",
-        "--steps", "20", "--out", str(out),
+        "--plant.max-steps", "20", "--out", str(out),
     )
     assert result.returncode == 0, result.stderr
     assert (out / "results.json").exists() and (out / "fig4a.png").exists()
@@ -88,10 +92,10 @@ def test_examples_run_quick(script, tmp_path):
 # Small runs of each experiment; RL trials long enough (~1-3 s each) to be caught mid-way.
 TINY_RUNS = {
     "table1": ["--quick", "--gplvm-max-iter", "200"],
-    "exp1": ["--quick", "--trials", "3", "--episodes", "40", "--steps", "300"],
-    "exp2": ["--quick", "--trials", "3", "--episodes", "20", "--steps", "500", "--test-episodes", "2",
+    "exp1": ["--quick", "--trials", "3", "--episodes", "40", "--plant.max-steps", "300"],
+    "exp2": ["--quick", "--trials", "3", "--episodes", "20", "--episode.max-steps", "500", "--test-episodes", "2",
              "--fig5-samples", "200", "--gplvm-max-iter", "100"],
-    "exp3": ["--quick", "--trials", "2", "--episodes", "3", "--steps", "8", "--test-episodes", "1",
+    "exp3": ["--quick", "--trials", "2", "--episodes", "3", "--episode.max-steps", "8", "--test-episodes", "1",
              "--map-grid", "8"],
 }
 # Ctrl-C must reach the child even where the test runner was started with SIGINT ignored
@@ -242,12 +246,14 @@ def test_fit_reports_bad_demonstration_files(tmp_path):
 
 
 def test_plot_redraws_the_finished_trials_of_a_partial_run(tmp_path):
-    from latentrl.experiments.exp1 import Exp1Preset, run_exp1
+    from latentrl.experiments.exp1 import Exp1Preset
+    from latentrl.experiments.registry import run_experiment
+    from latentrl.experiments.presets import with_overrides
     from latentrl.experiments.results import write_npz
     from latentrl.experiments.runner import finished_trials, load_arrays
 
-    run_exp1(dataclasses.replace(Exp1Preset.quick(), trials=2, episodes=5, steps=20), tmp_path / "run",
-             progress=False)
+    run_experiment("exp1", with_overrides(Exp1Preset.quick(), {"trials": 2, "episodes": 5, "plant.max_steps": 20}),
+             tmp_path / "run", progress=False)
     arrays = load_arrays(tmp_path / "run")
     arrays["full_end"][1] = -1  # as an interrupted run leaves it: full trial 2 not run
     arrays["full"][1] = np.nan

@@ -6,17 +6,46 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from latentrl import GPLVM, PCA
+from latentrl import GPLVM, PCA, Task, load_demos
 from latentrl._native import arms_ik
 from latentrl.datasets import arm_postures, bimanual_pairs
-from latentrl import humanoid, load_demos
-from latentrl.envs import BimanualReachEnv, HumanoidLiftEnv, LatentSpaceWrapper, TwoArmsEnv
+from latentrl.envs import BimanualReachEnv, LatentSpaceWrapper, TaskEnv, shipped_demos
+from latentrl.experiments.exp3 import demos_path
 
 IDS = sorted(env_id for env_id in gym.registry if env_id.startswith("latentrl/"))
 
 
+def TwoArmsEnv(**kwargs):
+    """Experiment 2's arms: the environment of `latentrl/TwoArms-v0` (no time limit)."""
+    return TaskEnv("two_arms", **kwargs)
+
+
+def HumanoidLiftEnv(**kwargs):
+    """Experiment 3's humanoid: the environment of `latentrl/HumanoidLift-v0` (no time limit)."""
+    return TaskEnv("humanoid_lift", **kwargs)
+
+
+class CountingPlant:
+    """The native plant, counting its steps (everything else passes through)."""
+
+    def __init__(self, plant):
+        self.plant, self.steps = plant, 0
+
+    def step(self, target):
+        self.steps += 1
+        return self.plant.step(target)
+
+    def __getattr__(self, name):
+        return getattr(self.plant, name)
+
+
 def test_every_task_is_registered():
     assert IDS == ["latentrl/BimanualReach-v0", "latentrl/HumanoidLift-v0", "latentrl/TwoArms-v0"]
+    for env_id, name in (("latentrl/TwoArms-v0", "two_arms"), ("latentrl/HumanoidLift-v0", "humanoid_lift")):
+        env = gym.make(env_id)
+        assert isinstance(env.unwrapped, TaskEnv) and env.unwrapped.task.name == name
+        assert env.spec.max_episode_steps == Task.shipped(name).to_dict()["episode"]["max_steps"]
+        env.close()
 
 
 @pytest.mark.parametrize("env_id", IDS)
@@ -84,27 +113,37 @@ def test_two_arms_episode_ends():
 def test_two_arms_observation_is_posture_then_hands():
     env = TwoArmsEnv()
     obs, _ = env.reset(seed=1)
+    assert obs.shape == (4 + 6,)
     np.testing.assert_array_equal(obs[:4], env.posture)
-    np.testing.assert_allclose(obs[4:6] + [0.1, 0.0], obs[6:], atol=1e-4)
+    np.testing.assert_array_equal(obs[4:], env.effectors())
+    np.testing.assert_allclose(obs[4:7] + [0.1, 0.0, 0.0], obs[7:10], atol=1e-4)
+    np.testing.assert_allclose(obs[[6, 9]], 0.0, atol=1e-5)  # planar in z = 0
 
 
 def test_humanoid_holds_still_then_drops_or_falls():
     env = HumanoidLiftEnv()
+    base = env.task.row_slices()["base_position"]
+    grip = env.task.to_dict()["constraints"][0]
+    assert grip["kind"] == "distance" and grip["value"] == 0.10
     obs, _ = env.reset(seed=0)
     assert obs.shape == (25,) and np.array_equal(obs[:19], env.posture)
-    start_base = env.sim.base_position()
+    start_base = env.plant.row()[base]
     for _ in range(20):  # 1 s of zero actions: the targets hold, the robot stands
         obs, reward, terminated, truncated, info = env.step(np.zeros(19))
         assert not terminated and not truncated and 0 < reward < 1
-    assert np.linalg.norm(env.sim.base_position() - start_base) < 0.02
-    grip = np.linalg.norm(obs[22:25] - obs[19:22])
-    assert abs(grip - humanoid.GRIP_WIDTH) < 0.005
-    # Opening both shoulders spreads the hands: the object drops.
+    assert np.linalg.norm(env.plant.row()[base] - start_base) < 0.02
+    hands = np.linalg.norm(obs[22:25] - obs[19:22])
+    assert abs(hands - grip["value"]) < 0.005
+    assert env.plant.constraint_errors()[0] == pytest.approx(hands - grip["value"], abs=1e-9)
+    # Opening both shoulders, step after step, spreads the hands: the object drops.
     j = env.joint_names
     spread = np.zeros(19)
     spread[j.index("l_shoulder_roll")], spread[j.index("r_shoulder_roll")] = 0.1, -0.1
     env.reset(seed=0)
-    _, reward, terminated, _, info = env.step(spread)
+    for _ in range(5):
+        _, reward, terminated, _, info = env.step(spread)
+        if terminated:
+            break
     assert terminated and info["end_reason"] == "drop" and reward < 0
     # Tipping both ankles forward, step after step, topples the robot; the grip holds.
     tip = np.zeros(19)
@@ -118,8 +157,12 @@ def test_humanoid_holds_still_then_drops_or_falls():
 
 
 def test_humanoid_reward_peaks_at_the_highest_demonstrated_hands():
-    env = HumanoidLiftEnv()
-    demos = load_demos(humanoid.demos_path(), expected_joints=env.joint_names).postures
+    # Without the block (the straight-arm demos 0-2 touch it, so they may not start an episode).
+    lift = Task.shipped("humanoid_lift")
+    env = TaskEnv(lift.replace({"obstacles": []}), shipped_demos("humanoid_lift"))
+    demos = load_demos(demos_path(), expected_joints=env.joint_names).postures
+    with pytest.raises(ValueError, match="breaks a rule of the task: obstacle"):
+        TaskEnv(lift).reset(options={"posture": demos[0]})
     rewards = []
     for pose in demos:
         env.reset(options={"posture": pose})
@@ -130,7 +173,8 @@ def test_humanoid_reward_peaks_at_the_highest_demonstrated_hands():
 
 @pytest.mark.filterwarnings("ignore:.*different from the unwrapped")
 def test_latent_wrapper_on_the_humanoid_passes_check_env():
-    demos = load_demos(humanoid.demos_path(), expected_joints=HumanoidLiftEnv().joint_names).postures
+    task = Task.shipped("humanoid_lift")
+    demos = load_demos(demos_path(), expected_joints=task.joint_names).postures
     model = GPLVM(max_iter=100, random_state=0).fit(demos)
     wrapped = LatentSpaceWrapper(gym.make("latentrl/HumanoidLift-v0"), model)
     check_env(wrapped)
@@ -139,8 +183,7 @@ def test_latent_wrapper_on_the_humanoid_passes_check_env():
     wrapped.step(u)
     # The servo targets are the decoded latent target (clipped to the joint limits).
     target = model.inverse_transform((z + u)[None])[0]
-    lower, upper = humanoid.model().lower, humanoid.model().upper
-    np.testing.assert_allclose(wrapped.unwrapped.sim.targets(), np.clip(target, lower, upper), atol=1e-9)
+    np.testing.assert_allclose(wrapped.unwrapped.plant.targets(), np.clip(target, task.lower, task.upper), atol=1e-9)
 
 
 @pytest.fixture(scope="module")
@@ -166,7 +209,7 @@ def test_latent_wrapper_steps_through_the_decoder(arms_gplvm):
     z2, reward, terminated, _, info = env.step(u)
     target = arms_gplvm.inverse_transform((z + u)[None])[0]
     assert not terminated and info["end_reason"] is None
-    np.testing.assert_allclose(env.unwrapped.sim.targets(), target, atol=1e-12)
+    np.testing.assert_allclose(env.unwrapped.plant.targets(), target, atol=1e-12)
     np.testing.assert_allclose(z2, arms_gplvm.transform(env.unwrapped.posture[None])[0])
 
 
@@ -178,10 +221,24 @@ def test_latent_wrapper_refuses_box_exits_and_uncertain_targets(arms_gplvm):
     assert terminated and reward == -1.0 and info["end_reason"] == "box_exit"
     gated = LatentSpaceWrapper(TwoArmsEnv(), arms_gplvm, variance_threshold=1e-12)
     gated.reset(seed=0)
-    before = gated.unwrapped.sim.time
+    plant = gated.unwrapped.plant = CountingPlant(gated.unwrapped.plant)
+    before = plant.joint_positions(), plant.targets()
     _, reward, terminated, _, info = gated.step(np.zeros(2))
-    assert terminated and reward == -1.0 and info["end_reason"] == "gated"
-    assert gated.unwrapped.sim.time == before  # no plant step
+    assert terminated and reward == -1.0 and info["end_reason"] == "variance_gate"
+    assert plant.steps == 0  # no plant step
+    np.testing.assert_array_equal(plant.joint_positions(), before[0])
+    np.testing.assert_array_equal(plant.targets(), before[1])
+
+
+def test_the_wrapper_penalty_is_the_tasks():
+    env = LatentSpaceWrapper(
+        TaskEnv(Task.shipped("two_arms").replace({"episode.penalty": -3.0}), shipped_demos("two_arms")),
+        PCA().fit(arm_postures(20, np.random.default_rng(0))),
+        latent_box=([-1e-9, -1e-9], [1e-9, 1e-9]),
+    )
+    env.reset(seed=0)
+    _, reward, terminated, _, info = env.step(env.action_space.high)
+    assert terminated and reward == -3.0 and info["end_reason"] == "box_exit"
 
 
 def test_bad_arguments():
@@ -189,12 +246,18 @@ def test_bad_arguments():
         BimanualReachEnv(drop_tolerance=0.0)
     with pytest.raises(ValueError, match="render_mode"):
         TwoArmsEnv(render_mode="human")
+    with pytest.raises(ValueError, match="max_step"):
+        TwoArmsEnv(max_step=0.0)
     with pytest.raises(ValueError, match="options\\['posture'\\]"):
         BimanualReachEnv().reset(options={"posture": [0.0, 1.0]})
     with pytest.raises(ValueError, match="expected 19 finite values"):
         HumanoidLiftEnv().reset(options={"posture": np.zeros(4)})
+    with pytest.raises(ValueError, match="breaks a rule of the task: box_exit"):  # outside the joint limits
+        TwoArmsEnv().reset(options={"posture": np.full(4, 100.0)})
     with pytest.raises(ValueError, match="start_noise"):
-        HumanoidLiftEnv(start_noise=-0.1)
+        TaskEnv(Task.shipped("humanoid_lift").replace({"episode.start_noise": -0.1}))
+    with pytest.raises(ValueError, match="no shipped task 'three_arms'"):
+        TaskEnv("three_arms")
     pca3 = PCA().fit(np.random.default_rng(0).normal(size=(10, 3)))
     with pytest.raises(ValueError, match="postures of 4 values"):
         LatentSpaceWrapper(BimanualReachEnv(), pca3)

@@ -7,24 +7,26 @@ import numpy as np
 import pytest
 
 from latentrl.experiments import exp1, exp1_figures
-from latentrl.experiments.exp1 import Exp1Preset, run_exp1
+from latentrl.experiments.exp1 import Exp1Preset
+from latentrl.experiments.registry import run_experiment
+from latentrl.experiments.presets import with_overrides
 from latentrl.experiments.runner import run_rl
 from learning import assert_separated, control
 
-TINY = dataclasses.replace(Exp1Preset.quick(), trials=2, episodes=40, steps=100)
+TINY = with_overrides(Exp1Preset.quick(), {"trials": 2, "episodes": 40, "plant.max_steps": 100})
 
 
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("exp1_quick")
-    meta = run_exp1(Exp1Preset.quick(), out, progress=False)
+    meta = run_experiment("exp1", Exp1Preset.quick(), out, progress=False)
     return out, meta
 
 
 @pytest.fixture(scope="module")
 def control_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("exp1_control")
-    run_exp1(control(Exp1Preset.quick()), out, progress=False)
+    run_experiment("exp1", control(Exp1Preset.quick()), out, progress=False)
     return out
 
 
@@ -68,14 +70,14 @@ def test_results_layout_follows_spec(quick_run):
 
 
 def test_same_seed_same_returns_and_other_seed_differs(tmp_path):
-    a = run_exp1(TINY, tmp_path / "a", progress=False)
-    b = run_exp1(TINY, tmp_path / "b", progress=False)
-    c = run_exp1(dataclasses.replace(TINY, seed=1), tmp_path / "c", progress=False)
+    a = run_experiment("exp1", TINY, tmp_path / "a", progress=False)
+    b = run_experiment("exp1", TINY, tmp_path / "b", progress=False)
+    c = run_experiment("exp1", dataclasses.replace(TINY, seed=1), tmp_path / "c", progress=False)
     assert a["trials"] == b["trials"] != c["trials"]
 
 
 def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
-    run_exp1(TINY, tmp_path / "whole", progress=False)
+    run_experiment("exp1", TINY, tmp_path / "whole", progress=False)
     calls = {"n": 0}
 
     def interrupting_setup(preset):
@@ -95,13 +97,13 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
         run_rl(TINY, tmp_path / "part", setup=interrupting_setup, figures=exp1_figures.figures, chunk=1, progress=False)
     with np.load(tmp_path / "part" / "returns.npz") as npz:
         assert (npz["full_end"][1] == -1).all() and (npz["full_end"][0] >= 0).all()
-    run_exp1(TINY, tmp_path / "part", progress=False)
+    run_experiment("exp1", TINY, tmp_path / "part", progress=False)
     with np.load(tmp_path / "whole" / "returns.npz") as whole, np.load(tmp_path / "part" / "returns.npz") as part:
         for key in whole.files:
             np.testing.assert_array_equal(whole[key], part[key], err_msg=key)
 
 
 def test_a_different_preset_in_the_same_directory_is_refused(tmp_path):
-    run_exp1(TINY, tmp_path, progress=False)
+    run_experiment("exp1", TINY, tmp_path, progress=False)
     with pytest.raises(ValueError, match="different preset"):
-        run_exp1(dataclasses.replace(TINY, beta=5.0), tmp_path, progress=False)
+        run_experiment("exp1", with_overrides(TINY, {"learner.beta": 5.0}), tmp_path, progress=False)

@@ -9,19 +9,26 @@ import sys
 import numpy as np
 import pytest
 
-from latentrl import _reference
-from latentrl._native import GpMap, InvalidInputError, run_arms_trials
+from latentrl import Task
+from latentrl._native import GpMap, InvalidInputError, run_task_trials
 from latentrl.experiments import exp2
-from latentrl.experiments.exp2 import Exp2Preset, run_exp2
+from latentrl.experiments.exp2 import Exp2Preset
+from latentrl.experiments.registry import run_experiment
+from latentrl.experiments.presets import with_overrides
 from latentrl.experiments.results import write_npz
 from learning import assert_separated, control
 
-TINY = dataclasses.replace(Exp2Preset.quick(), trials=2, episodes=6, steps=60, test_episodes=3)
+TINY = with_overrides(Exp2Preset.quick(), {"trials": 2, "episodes": 6, "episode.max_steps": 60, "test_episodes": 3})
 
 
 @pytest.fixture(scope="module")
 def fitted():
     return exp2.fit(Exp2Preset.quick())
+
+
+def arms(overrides=None):
+    quick = {"episode.max_steps": 40, "learner.initial_weight": 100.0, "learner.step": 0.5}
+    return Task.shipped("two_arms").replace({**quick, **(overrides or {})})
 
 
 def arms_kwargs(fitted, **overrides):
@@ -30,10 +37,10 @@ def arms_kwargs(fitted, **overrides):
         encoder=fitted.model.encoder_,
         latent_low=fitted.low,
         latent_high=fitted.high,
+        demos=fitted.demos,
         n_trials=2,
         episodes=3,
         base_seed=0,
-        config={"max_steps": 40, "initial_weight": 100.0, "step_fraction": 0.5},
     )
     kwargs.update(overrides)
     return kwargs
@@ -42,18 +49,6 @@ def arms_kwargs(fitted, **overrides):
 @pytest.mark.parametrize(
     ("overrides", "message"),
     [
-        ({"config": {"max_stepz": 3}}, 'unknown key "max_stepz"'),
-        ({"config": {"walls": [[0.0, 0.3, 1.0]]}}, "expected 4 numbers"),
-        ({"config": {"walls": 3}}, r'config\["walls"\]: expected a sequence'),
-        ({"config": {"walls": [[1.0, 0.3, 0.0, 0.4]]}}, "wall high corner"),
-        ({"config": {"theta": 0.0}}, "theta"),
-        ({"config": {"drop_tolerance": -1.0}}, "drop_tolerance"),
-        ({"config": {"solver_iterations": 0}}, r"solver_iterations.* must lie in \[1,"),
-        ({"config": {"dt": float("nan")}}, "must be finite"),
-        ({"config": {"kp": -5.0}}, "kp"),
-        ({"config": {"left_hand": "left_paw"}}, "unknown link"),
-        ({"config": {"left_hand": 3}}, r'config\["left_hand"\]: expected a str'),
-        ({"config": {"gamma": 1.5}}, "gamma"),
         ({"n_trials": 0}, r"n_trials must lie in \[1,"),
         ({"test_episodes": -1}, r"test_episodes must lie in \[0,"),
         ({"test_episodes": 2, "record_test_episodes": [2]}, r"record_test_episodes\[i\] must lie in \[0, 1\]"),
@@ -62,75 +57,76 @@ def arms_kwargs(fitted, **overrides):
         ({"latent_low": np.zeros(3)}, r"latent_low: expected shape \(2,\)"),
         ({"latent_high": np.array([1.0, np.nan])}, "non-finite"),
         ({"progress": 1}, "progress: expected a callable"),
+        ({"weights": np.zeros(3)}, r"value weights: expected shape \(400,\), got \(3,\)"),
+        ({"demos": np.zeros((5, 3))}, "demonstration 0 has 3 values, the robot 4 actuated joints"),
     ],
 )
-def test_bad_inputs_raise_invalid_input(fitted, overrides, message):
+def test_bad_run_arguments_raise_invalid_input(fitted, overrides, message):
     with pytest.raises(InvalidInputError, match=message):
-        run_arms_trials(exp2.urdf_path(), **arms_kwargs(fitted, **overrides))
+        run_task_trials(arms()._native, **arms_kwargs(fitted, **overrides))
 
 
-def test_bad_robots_and_mismatched_maps_raise_invalid_input(fitted, tmp_path):
-    with pytest.raises(InvalidInputError, match="cannot read URDF file"):
-        run_arms_trials(tmp_path / "missing.urdf", **arms_kwargs(fitted))
-    with pytest.raises(InvalidInputError, match="malformed URDF"):
-        run_arms_trials("<robot name='x'><link", **arms_kwargs(fitted))
-    with pytest.raises(InvalidInputError, match="urdf: expected a path or URDF text"):
-        run_arms_trials(3.5, **arms_kwargs(fitted))
+def test_mismatched_maps_raise_invalid_input(fitted):
     # A decoder into 3 joints does not fit the 4-joint arms.
     z = fitted.model.Z_
     three = GpMap(z, fitted.demos[:, :3], np.array([1.0, 1.0, 1e-4]))
     with pytest.raises(InvalidInputError, match="dimension"):
-        run_arms_trials(exp2.urdf_path(), **arms_kwargs(fitted, decoder=three))
-    # A 3-D latent space has no 8-action set.
-    z3 = np.column_stack([z, z[:, :1]])
-    kwargs = arms_kwargs(fitted, decoder=GpMap(z3, fitted.demos, np.array([1.0, 1.0, 1e-4])),
-                         latent_low=np.full(3, -3.0), latent_high=np.full(3, 3.0))
-    with pytest.raises(InvalidInputError, match="dimension"):
-        run_arms_trials(exp2.urdf_path(), **kwargs)
+        run_task_trials(arms()._native, **arms_kwargs(fitted, decoder=three))
+    # A 3-D latent box with a 2-D decoder.
+    kwargs = arms_kwargs(fitted, latent_low=np.full(3, -3.0), latent_high=np.full(3, 3.0))
+    with pytest.raises(InvalidInputError, match=r"latent_low: expected shape \(2,\)"):
+        run_task_trials(arms()._native, **kwargs)
 
 
-def test_records_tests_and_config_echo(fitted):
-    with open(exp2.urdf_path()) as f:
-        urdf_text = f.read()
+def test_records_tests_and_task_echo(fitted):
     calls = []
     kwargs = arms_kwargs(fitted, record_episodes=[0, 2], test_episodes=4, record_test_episodes=[1],
                          return_weights=True, progress=lambda done, total: calls.append((done, total)))
-    a = run_arms_trials(exp2.urdf_path(), **kwargs)
-    b = run_arms_trials(urdf_text, **kwargs)
+    a = run_task_trials(arms()._native, **kwargs)
+    b = run_task_trials(Task.from_dict(arms().to_dict(), arms().base_dir)._native, **kwargs)
     for key in ("returns", "ends", "steps", "reached", "passed", "test_returns", "test_ends", "test_passed",
                 "trajectories", "test_trajectories", "weights"):
         np.testing.assert_array_equal(a[key], b[key], err_msg=key)
     assert a["returns"].shape == a["passed"].shape == (2, 3)
     assert a["test_returns"].shape == a["test_reached"].shape == (2, 4)
-    assert a["trajectories"].shape == (2, 2, 41, 4) and a["test_trajectories"].shape == (2, 1, 41, 4)
+    assert a["trajectories"].shape == (2, 2, 41, 17) and a["test_trajectories"].shape == (2, 1, 41, 17)
     assert a["weights"].shape == (2, 400) and a["n_actions"] == 8 and a["n_centres"] == 400
     assert calls[-1] == (2 * (3 + 4), 14)
     # Test episodes start with both hands below the wall (y < 0.30), holding the object.
     start = a["test_trajectories"][:, 0, 0]
-    assert np.all(start[:, [1, 3]] < 0.30)
-    np.testing.assert_allclose(start[:, 2:] - start[:, :2], np.tile([0.1, 0.0], (2, 1)), atol=0.005)
+    assert np.all(start[:, [1, 4]] < 0.30)
+    np.testing.assert_allclose(start[:, 3:5] - start[:, :2], np.tile([0.1, 0.0], (2, 1)), atol=0.005)
     # "passed" agrees with the recorded path: started below, both hands above 0.37 later.
     path = a["test_trajectories"][:, 0]
-    lower_hand = np.nan_to_num(np.minimum(path[:, 1:, 1], path[:, 1:, 3]), nan=-1.0)
+    lower_hand = np.nan_to_num(np.minimum(path[:, 1:, 1], path[:, 1:, 4]), nan=-1.0)
     above = (lower_hand > 0.37).any(axis=1)
     np.testing.assert_array_equal(a["test_passed"][:, 1], above)
-    config = a["config"]
-    assert config["solver_iterations"] == 2 and config["alpha"] == 0.8 and config["beta"] == 20.0
-    assert config["walls"] == [[-1.0, 0.30, -0.36, 0.37], [-0.06, 0.30, 1.0, 0.37]]
-    assert config["start"] == "uniform" and config["max_steps"] == 40
+    task = a["task"]
+    assert task["physics"]["solver_iterations"] == 2 and task["learner"]["alpha"] == 0.8
+    assert task["learner"]["beta"] == 20.0 and task["episode"]["max_steps"] == 40
+    assert [list(o["min"]) for o in task["obstacles"]] == [[-1.0, 0.30, -1.0], [-0.06, 0.30, -1.0]]
+
+
+def test_a_rollout_is_greedy_and_frozen(fitted):
+    trained = run_task_trials(arms()._native, **arms_kwargs(fitted, return_weights=True))
+    w = trained["weights"][0]
+    kwargs = arms_kwargs(fitted, n_trials=1, weights=w, rollout=True, return_weights=True)
+    once, again = run_task_trials(arms()._native, **kwargs), run_task_trials(arms()._native, **kwargs)
+    np.testing.assert_array_equal(once["weights"][0], w, err_msg="a rollout learns nothing")
+    np.testing.assert_array_equal(once["returns"], again["returns"])
 
 
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("exp2_quick")
-    meta = run_exp2(Exp2Preset.quick(), out, progress=False)
+    meta = run_experiment("exp2", Exp2Preset.quick(), out, progress=False)
     return out, meta
 
 
 @pytest.fixture(scope="module")
 def control_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("exp2_control")
-    run_exp2(control(Exp2Preset.quick()), out, progress=False)
+    run_experiment("exp2", control(Exp2Preset.quick()), out, progress=False)
     return out
 
 
@@ -170,14 +166,14 @@ def test_results_layout_follows_spec(quick_run):
     saved = json.loads((out / "results.json").read_text())
     preset = Exp2Preset.quick()
     assert saved["preset"] == {"name": "Exp2Preset", **dataclasses.asdict(preset)}
-    assert saved["setup"]["walls"] == [list(w) for w in exp2.WALLS]
+    assert saved["setup"]["task"] == exp2.task_of(preset).to_dict()
     assert set(saved["trials"]) == {"latent"} and len(saved["trials"]["latent"]) == preset.trials
     assert {"test_success", "test_passed", "test_ends"} <= set(saved["trials"]["latent"]["0"])
     with np.load(out / "returns.npz") as npz:
         assert npz["latent"].shape == npz["latent_end"].shape == (preset.trials, preset.episodes)
         assert npz["latent_test"].shape == (preset.trials, preset.test_episodes)
         assert set(np.unique(npz["latent_end"])) <= {0, 1, 2, 3}
-        assert npz["latent_weights"].shape == (preset.trials, preset.rbf_per_dim**2)
+        assert npz["latent_weights"].shape == (preset.trials, 20**2)
     for fig in ("fig5", "fig6a", "fig6b", "fig6c", "fig6d"):
         for ext in ("png", "pdf"):
             assert (out / f"{fig}.{ext}").stat().st_size > 1000
@@ -185,10 +181,10 @@ def test_results_layout_follows_spec(quick_run):
 
 
 def test_same_seed_same_returns_and_a_missing_trial_is_rerun_identically(tmp_path):
-    a = run_exp2(TINY, tmp_path / "a", progress=False)
-    b = run_exp2(TINY, tmp_path / "b", progress=False)
+    a = run_experiment("exp2", TINY, tmp_path / "a", progress=False)
+    b = run_experiment("exp2", TINY, tmp_path / "b", progress=False)
     assert a["trials"] == b["trials"]
-    c = run_exp2(dataclasses.replace(TINY, seed=1), tmp_path / "c", progress=False)
+    c = run_experiment("exp2", dataclasses.replace(TINY, seed=1), tmp_path / "c", progress=False)
     assert c["trials"] != a["trials"]
     # Mark trial 1 of b as not run (as an interrupted run leaves it): resuming reruns it alone.
     with np.load(tmp_path / "b" / "returns.npz") as npz:
@@ -196,40 +192,32 @@ def test_same_seed_same_returns_and_a_missing_trial_is_rerun_identically(tmp_pat
     arrays["latent_end"][1] = -1
     arrays["latent_test"][1] = np.nan
     write_npz(tmp_path / "b" / "returns.npz", arrays)
-    run_exp2(TINY, tmp_path / "b", progress=False)
+    run_experiment("exp2", TINY, tmp_path / "b", progress=False)
     with np.load(tmp_path / "a" / "returns.npz") as whole, np.load(tmp_path / "b" / "returns.npz") as resumed:
         assert whole.files == resumed.files
         for key in whole.files:
             np.testing.assert_array_equal(whole[key], resumed[key], err_msg=key)
 
 
-def test_value_function_matches_the_learners_grid_order():
-    # Weight 1 on the centre at grid index (i0, i1) = (3, 0) (dimension 0 fastest): V peaks there.
-    low, high = np.array([0.0, 0.0]), np.array([1.0, 2.0])
-    w = np.zeros(16)
-    w[3] = 1.0
-    points = np.array([[1.0, 0.0], [0.0, 2.0]])
-    v = _reference.value_function(w, low, high, points)
-    assert v[0] > 0.25 and v[1] < 1e-3, "the peak is at (i0, i1) = (3, 0), not (0, 3)"
-    np.testing.assert_allclose(_reference.value_function(np.full(16, 7.0), low, high, points), 7.0)
-
-
 def test_preset_validation():
-    with pytest.raises(ValueError, match="gamma"):
-        dataclasses.replace(Exp2Preset(), gamma=1.0).validate()
-    with pytest.raises(ValueError, match="solver_iterations"):
-        dataclasses.replace(Exp2Preset(), solver_iterations=0).validate()
+    with pytest.raises(ValueError, match=r"learner.gamma must lie in \[0, 1\), got 1"):
+        with_overrides(Exp2Preset(), {"learner.gamma": 1.0}).validate()
+    with pytest.raises(ValueError, match=r"physics.solver_iterations must be an integer in \[1, 1000\], got 0"):
+        with_overrides(Exp2Preset(), {"physics.solver_iterations": 0}).validate()
     with pytest.raises(ValueError, match="test_episodes"):
         dataclasses.replace(Exp2Preset(), test_episodes=-1).validate()
+    with pytest.raises(ValueError, match="unknown preset fields"):
+        with_overrides(Exp2Preset(), {"stepz": 3})
     quick = Exp2Preset.quick()
-    assert (quick.initial_weight, quick.step_fraction, quick.episodes, quick.steps, quick.trials,
-            quick.test_episodes) == (100.0, 0.5, 300, 1000, 3, 50)
+    config = exp2.task_of(quick).to_dict()
+    assert (config["learner"]["initial_weight"], config["learner"]["step"], quick.episodes,
+            config["episode"]["max_steps"], quick.trials, quick.test_episodes) == (100.0, 0.5, 300, 1000, 3, 50)
     Exp2Preset().validate()
 
 
 def test_cli_runs_exp2_tiny(tmp_path):
     cmd = [sys.executable, "-m", "latentrl", "run", "exp2", "--quick", "--no-progress", "--trials", "1",
-           "--episodes", "3", "--steps", "30", "--test-episodes", "2", "--out", str(tmp_path)]
+           "--episodes", "3", "--episode.max-steps", "30", "--test-episodes", "2", "--out", str(tmp_path)]
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     saved = json.loads((tmp_path / "results.json").read_text())

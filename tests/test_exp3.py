@@ -10,14 +10,16 @@ import sys
 import numpy as np
 import pytest
 
-from latentrl import humanoid
-from latentrl._native import InvalidInputError, run_lift_trials
-from latentrl.experiments import exp3, exp3_figures
-from latentrl.experiments.exp3 import Exp3Preset, run_exp3
+from latentrl._native import run_task_trials
+from latentrl.experiments import exp3
+from latentrl.experiments.exp3 import Exp3Preset
+from latentrl.experiments.registry import run_experiment
+from latentrl.experiments.presets import with_overrides
 from latentrl.experiments.results import write_npz
 from learning import assert_separated, control
 
-TINY = dataclasses.replace(Exp3Preset.quick(), trials=2, episodes=3, steps=8, test_episodes=1, map_grid=8)
+TINY = with_overrides(Exp3Preset.quick(), {"trials": 2, "episodes": 3, "episode.max_steps": 8, "test_episodes": 1,
+                                           "map_grid": 8})
 
 
 @pytest.fixture(scope="module")
@@ -25,83 +27,37 @@ def fitted():
     return exp3.fit(Exp3Preset.quick())
 
 
-def lift_kwargs(fitted, **overrides):
-    kwargs = dict(
-        decoder=fitted.model.decoder_,
-        encoder=fitted.model.encoder_,
-        latent_low=fitted.low,
-        latent_high=fitted.high,
-        n_trials=2,
-        episodes=2,
-        base_seed=0,
-        config={"max_steps": 5, "initial_weight": 100.0, "step_fraction": 0.5},
-    )
-    kwargs.update(overrides)
-    return kwargs
-
-
-@pytest.mark.parametrize(
-    ("overrides", "message"),
-    [
-        ({"config": {"max_stepz": 3}}, 'unknown key "max_stepz"'),
-        ({"config": {"obstacles": [[0.2, 0.0, 0.1]]}}, "expected 6 numbers"),
-        ({"config": {"obstacles": 3}}, r'config\["obstacles"\]: expected a sequence'),
-        ({"config": {"obstacles": [[0.2, 0.0, 0.1, 0.05, -0.1, 0.1]]}}, "half_extents"),
-        ({"config": {"target": [0.1] * 5}}, "expected 6 numbers"),
-        ({"config": {"drop_tolerance": 0.0}}, "drop_tolerance"),
-        ({"config": {"base_height_fraction": 1.5}}, "base_height_fraction"),
-        ({"config": {"max_force": -1.0}}, "max_force"),
-        ({"config": {"hands": ["l_hand"]}}, r'config\["hands"\]: expected two link names'),
-        ({"config": {"hands": ["l_paw", "r_hand"]}}, "unknown link"),
-        ({"config": {"start_posture": [0.0] * 3}}, r"posture"),
-        ({"config": {"start_posture": "x"}}, r'config\["start_posture"\]: expected a sequence'),
-        ({"config": {"solver_iterations": 0}}, r"solver_iterations.* must lie in \[1,"),
-        ({"config": {"pgs_iterations": 0}}, r"pgs_iterations.* must lie in \[1,"),
-        ({"n_trials": 0}, r"n_trials must lie in \[1,"),
-        ({"decoder": "not a map"}, "decoder: expected a GpMap"),
-        ({"latent_low": np.zeros(3)}, r"latent_low: expected shape \(2,\)"),
-    ],
-)
-def test_bad_inputs_raise_invalid_input(fitted, overrides, message):
-    with pytest.raises(InvalidInputError, match=message):
-        run_lift_trials(str(humanoid.urdf_path()), **lift_kwargs(fitted, **overrides))
-
-
-def test_records_postures_and_echoes_the_config(fitted):
-    kwargs = lift_kwargs(fitted, record_episodes=[1], test_episodes=1, record_test_episodes=[0],
-                         return_weights=True, config={**exp3.native_config(TINY, fitted.demos[0]), "max_steps": 5})
-    a = run_lift_trials(str(humanoid.urdf_path()), **kwargs)
-    assert a["returns"].shape == (2, 2) and a["trajectories"].shape == (2, 1, 6, exp3.TASK_HEAD + 19)
+def test_runs_record_postures_and_echo_the_task(fitted):
+    task = exp3.task_of(with_overrides(TINY, {"episode.max_steps": 5}))
+    a = run_task_trials(task._native, decoder=fitted.model.decoder_, encoder=fitted.model.encoder_,
+                        latent_low=fitted.low, latent_high=fitted.high, demos=fitted.demos, n_trials=2, episodes=2,
+                        base_seed=0, record_episodes=[1], test_episodes=1, record_test_episodes=[0], return_weights=True)
+    rows = task.row_slices()
+    assert a["returns"].shape == (2, 2) and a["trajectories"].shape == (2, 1, 6, task.row_len) == (2, 1, 6, 32)
     assert np.isfinite(a["returns"]).all() and set(np.unique(a["ends"])) <= {0, 1, 2, 3, 4}
     start = a["trajectories"][:, 0, 0]
     # Starts hold the object, stand on the floor, and the row's joints are a posture of the robot.
     grip = np.linalg.norm(start[:, 3:6] - start[:, :3], axis=1)
-    assert np.all(np.abs(grip - humanoid.GRIP_WIDTH) <= 0.02), grip
-    h = humanoid.model()
-    assert np.all((start[:, exp3.TASK_HEAD:] >= h.lower - 1e-9) & (start[:, exp3.TASK_HEAD:] <= h.upper + 1e-9))
-    np.testing.assert_allclose(np.linalg.norm(start[:, 9:13], axis=1), 1.0, atol=1e-6)
-    # The recorded base pose and joints give the recorded hands through the NumPy kinematics.
+    assert np.all(np.abs(grip - 0.10) <= 0.02), grip
+    joints = start[:, rows["joints"]]
+    assert np.all((joints >= task.lower - 1e-9) & (joints <= task.upper + 1e-9))
+    np.testing.assert_allclose(np.linalg.norm(start[:, rows["base_quaternion"]], axis=1), 1.0, atol=1e-6)
+    # The recorded base pose and joints give the recorded hands through the native kinematics
+    # (f64 FK of the recorded values against the f32 world's frames: 2e-8 m seen, f32 ε × 0.2 m).
+    plant = task.plant(fitted.demos)
+    base = np.r_[rows["base_position"], rows["base_quaternion"]]
     for row in start:
-        poses = h.link_poses(row[exp3.TASK_HEAD:], exp3_figures._base(row))
-        np.testing.assert_allclose(poses["l_hand"][:3, 3], row[:3], atol=2e-3)
-    config = a["config"]
-    assert config["obstacles"] == [list(exp3.OBSTACLE)] and config["solver_iterations"] == 1
-    assert config["pgs_iterations"] == 4
-    assert config["kp"] == 8.0 and config["max_force"] == 1.2 and config["max_steps"] == 5
-    assert config["target"] == pytest.approx(list(exp3.target()))
-
-
-def test_native_default_physics_is_the_python_one(fitted):
-    # Keys left out of `config` take the Rust defaults (sim::humanoid::sim_options): the same
-    # servo and physics as humanoid.SERVO / PHYSICS, which the Python side builds its Sims with.
-    config = run_lift_trials(str(humanoid.urdf_path()), **lift_kwargs(fitted, n_trials=1, episodes=1))["config"]
-    assert {k: config[k] for k in (*humanoid.SERVO, *humanoid.PHYSICS)} == {**humanoid.SERVO, **humanoid.PHYSICS}
+        poses = plant.pose_links(row[base], row[rows["joints"]])
+        np.testing.assert_allclose(poses[task.link_names.index("l_hand")][:3], row[:3], rtol=0, atol=1e-6)
+    config = a["task"]
+    assert config["physics"]["solver_iterations"] == 1 and config["physics"]["pgs_iterations"] == 4
+    assert config["servo"]["kp"] == 8.0 and config["servo"]["max_force"] == 1.2 and config["episode"]["max_steps"] == 5
 
 
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("exp3_quick")
-    meta = run_exp3(Exp3Preset.quick(), out, progress=False)
+    meta = run_experiment("exp3", Exp3Preset.quick(), out, progress=False)
     return out, meta
 
 
@@ -110,12 +66,13 @@ def test_quick_preset_ends_episodes_correctly(quick_run):
     terminal step (obstacle, box, drop, fall) carries the −1 and a time-out ran all steps."""
     out, meta = quick_run
     preset = Exp3Preset.quick()
+    max_steps = exp3.task_of(preset).to_dict()["episode"]["max_steps"]
     with np.load(out / "returns.npz") as npz:
         returns, ends, steps = npz["latent"], npz["latent_end"], npz["latent_steps"]
     assert np.isfinite(returns).all()
     assert set(np.unique(ends)) <= {0, 1, 2, 3, 4}
-    assert np.all(steps[ends == 0] == preset.steps)
-    assert np.all((steps[ends != 0] >= 1) & (steps[ends != 0] <= preset.steps))
+    assert max_steps == 100 and np.all(steps[ends == 0] == max_steps)
+    assert np.all((steps[ends != 0] >= 1) & (steps[ends != 0] <= max_steps))
     assert np.all(returns <= steps) and np.all(returns >= -1.0)
     assert np.all(returns[ends != 0] <= steps[ends != 0] - 1.0 + 1e-9), "penalty on terminal steps"
     assert (ends == 0).mean() >= 0.3, "most starts hold the object without falling"
@@ -126,7 +83,7 @@ def test_quick_preset_ends_episodes_correctly(quick_run):
 @pytest.fixture(scope="module")
 def control_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("exp3_control")
-    run_exp3(control(Exp3Preset.quick()), out, progress=False)
+    run_experiment("exp3", control(Exp3Preset.quick()), out, progress=False)
     return out
 
 
@@ -149,13 +106,13 @@ def test_results_layout_follows_spec(quick_run):
     saved = json.loads((out / "results.json").read_text())
     preset = Exp3Preset.quick()
     assert saved["preset"] == {"name": "Exp3Preset", **dataclasses.asdict(preset)}
-    assert saved["setup"]["obstacle"] == list(exp3.OBSTACLE)
+    assert saved["setup"]["task"] == exp3.task_of(preset).to_dict()
     assert set(saved["trials"]) == {"latent"} and len(saved["trials"]["latent"]) == preset.trials
     with np.load(out / "returns.npz") as npz:
         assert npz["latent"].shape == npz["latent_end"].shape == (preset.trials, preset.episodes)
         assert npz["latent_test"].shape == (preset.trials, preset.test_episodes)
-        assert npz["latent_weights"].shape == (preset.trials, preset.rbf_per_dim**2)
-        assert npz["latent_test_paths"].shape[-1] == exp3.TASK_HEAD + 19
+        assert npz["latent_weights"].shape == (preset.trials, 20**2)
+        assert npz["latent_test_paths"].shape[-1] == 6 + 7 + 19
     for fig in ("fig7b", "fig7c", "fig7d", "fig7e", "fig8"):
         for ext in ("png", "pdf"):
             assert (out / f"{fig}.{ext}").stat().st_size > 1000
@@ -163,45 +120,50 @@ def test_results_layout_follows_spec(quick_run):
 
 
 def test_same_seed_same_results_and_a_missing_trial_is_rerun_identically(tmp_path):
-    a = run_exp3(TINY, tmp_path / "a", progress=False)
-    b = run_exp3(TINY, tmp_path / "b", progress=False)
+    a = run_experiment("exp3", TINY, tmp_path / "a", progress=False)
+    b = run_experiment("exp3", TINY, tmp_path / "b", progress=False)
     assert a["trials"] == b["trials"]
     with np.load(tmp_path / "b" / "returns.npz") as npz:
         arrays = {k: npz[k] for k in npz.files}
     arrays["latent_end"][1] = -1
     write_npz(tmp_path / "b" / "returns.npz", arrays)
-    run_exp3(TINY, tmp_path / "b", progress=False)
+    run_experiment("exp3", TINY, tmp_path / "b", progress=False)
     with np.load(tmp_path / "a" / "returns.npz") as whole, np.load(tmp_path / "b" / "returns.npz") as resumed:
         assert whole.files == resumed.files
         for key in whole.files:
             np.testing.assert_array_equal(whole[key], resumed[key], err_msg=key)
 
 
-def test_rest_map_marks_the_demos():
-    codes, hands = exp3.rest_map(Exp3Preset(), exp3.fit(Exp3Preset.quick()).demos)
+def test_the_plant_marks_the_demos_and_the_target_is_the_top_demo():
+    fitted = exp3.fit(Exp3Preset.quick())
+    task = exp3.task_of(Exp3Preset())
+    codes, hands = task.plant(fitted.demos).classify(fitted.demos)
     np.testing.assert_array_equal(codes, [1, 1, 1, 0, 0, 0, 0])
-    np.testing.assert_allclose(hands[6], exp3.target(), atol=1e-9)
+    np.testing.assert_allclose(hands[6], np.ravel(task.to_dict()["target"]["position"]), atol=1e-9)
 
 
 def test_preset_validation():
-    with pytest.raises(ValueError, match="start"):
-        dataclasses.replace(Exp3Preset(), start="anywhere").validate()
-    with pytest.raises(ValueError, match="gamma"):
-        dataclasses.replace(Exp3Preset(), gamma=1.0).validate()
-    with pytest.raises(ValueError, match="max_force"):
-        dataclasses.replace(Exp3Preset(), max_force=0.0).validate()
+    with pytest.raises(ValueError, match="episode.start: unknown variant `anywhere`"):
+        with_overrides(Exp3Preset(), {"episode.start": "anywhere"}).validate()
+    with pytest.raises(ValueError, match="learner.gamma"):
+        with_overrides(Exp3Preset(), {"learner.gamma": 1.0}).validate()
+    with pytest.raises(ValueError, match=r"servo.max_force must be >= 0 \(inf allowed\), got -1"):
+        with_overrides(Exp3Preset(), {"servo.max_force": -1.0}).validate()
     quick = Exp3Preset.quick()
-    assert (quick.trials, quick.episodes, quick.steps, quick.initial_weight) == (2, 300, 100, 100.0)
+    config = exp3.task_of(quick).to_dict()
+    assert (quick.trials, quick.episodes, config["episode"]["max_steps"], config["learner"]["initial_weight"]) == (
+        2, 300, 100, 100.0)
     Exp3Preset().validate()
-    assert exp3.native_config(dataclasses.replace(quick, start="demo"), np.zeros(19))["start"] == "plant"
 
 
 def test_cli_runs_exp3_tiny(tmp_path):
     cmd = [sys.executable, "-m", "latentrl", "run", "exp3", "--quick", "--no-progress", "--trials", "1",
-           "--episodes", "2", "--steps", "5", "--test-episodes", "1", "--map-grid", "6", "--start", "demo",
+           "--episodes", "2", "--episode.max-steps", "5", "--test-episodes", "1", "--map-grid", "6",
+           "--episode.start", "demo",
            "--out", str(tmp_path)]
     result = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr
     saved = json.loads((tmp_path / "results.json").read_text())
-    assert saved["preset"]["start"] == "demo" and "test_success" in saved["trials"]["latent"]["0"]
+    assert saved["preset"]["task"]["episode.start"] == "demo" and saved["setup"]["task"]["episode"]["start"] == "demo"
+    assert "test_success" in saved["trials"]["latent"]["0"]
     assert (tmp_path / "fig8.png").is_file()

@@ -2,44 +2,61 @@
 
 import numpy as np
 import pytest
+from urdf_reference import pose_matrix, task_robot
 
 from latentrl import _native
 from latentrl.demos import load_demos
+from latentrl.experiments.exp3 import demos_path
 from latentrl.experiments.fallcheck import (
     COLUMNS,
     METHODS,
     FallCheckPreset,
+    fall_check,
     format_table,
+    humanoid,
     run_fallcheck,
 )
-from latentrl.humanoid import GRIP_WIDTH, demos_path, fall_check, hull_margin, model
+
+SOLES = ("l_foot", "r_foot")
 
 
-def test_robot_has_the_documented_size():
-    h = model()
-    assert len(h.joint_names) == 19
-    assert h.joint_names[0] == "head_yaw" and "l_shoulder_pitch" in h.joint_names
-    mass = sum(m for _, m, _ in h._inertials)
-    assert 1.2 <= mass <= 1.5
-    poses = h.on_ground(np.zeros(19))
+@pytest.fixture(scope="module")
+def robot():
+    """The NumPy reference kinematics of the humanoid's URDF (independent of rapier)."""
+    return task_robot(humanoid())
+
+
+def test_robot_has_the_documented_size(robot):
+    assert len(robot.joint_names) == 19 and robot.joint_names == humanoid().joint_names
+    assert robot.joint_names[0] == "head_yaw" and "l_shoulder_pitch" in robot.joint_names
+    assert 1.2 <= robot.mass() <= 1.5
+    poses = robot.standing(np.zeros(19), "l_foot")
     assert 0.339 <= poses["head"][2, 3] + 0.06 <= 0.40
-    assert np.isclose(min(c[2] for c in h.sole_corners(poses, "l_foot")), 0.0)
+    assert abs(robot.box_corners(poses, "r_foot")[:, 2].min()) < 1e-9  # both soles on the floor
 
 
 @pytest.mark.parametrize("heel, margin", [(False, 0.045), (True, 0.016)])
-def test_demos_grip_the_object_and_balance_as_documented(heel, margin):
-    h = model()
-    X = load_demos(demos_path(heel=heel), expected_joints=h.joint_names).postures
+def test_demos_grip_the_object_and_balance_as_documented(robot, heel, margin):
+    X = load_demos(demos_path(heel=heel), expected_joints=robot.joint_names).postures
     assert X.shape == (7, 19)
-    assert np.all((X >= h.lower) & (X <= h.upper))
+    assert np.all((X >= robot.lower) & (X <= robot.upper))
     assert np.sum(np.ptp(X, axis=0) > np.radians(10)) >= 10
+    width = humanoid().to_dict()["constraints"][0]["value"]
+    plant = humanoid().plant(X)
+    index = robot.joint_names.index
     for q in X:
-        b = h.balance(q)
-        assert abs(b["grip_error"]) < 1e-4 and abs(b["margin"] - margin) < 1e-3
+        poses = robot.standing(q, "l_foot")
+        grip = np.linalg.norm(poses["l_hand"][:3, 3] - poses["r_hand"][:3, 3]) - width
+        reference = robot.support_margin(poses, SOLES)
+        assert abs(grip) < 1e-4 and abs(reference - margin) < 1e-3
+        # the native plant standing at q measures the same (rapier's kinematics)
+        plant.reset(q)  # (the straight-arm demos touch the block: a rule broken, not a placement)
+        assert plant.constraint_errors()[0] == pytest.approx(grip, abs=1e-7)
+        assert plant.support_margin() == pytest.approx(reference, abs=1e-6)
         # sagittal: left and right mirror each other
         for joint in ("shoulder_pitch", "elbow", "hip_pitch", "knee", "ankle_pitch"):
-            assert q[h.index(f"l_{joint}")] == q[h.index(f"r_{joint}")]
-        assert q[h.index("l_shoulder_roll")] == -q[h.index("r_shoulder_roll")]
+            assert q[index(f"l_{joint}")] == q[index(f"r_{joint}")]
+        assert q[index("l_shoulder_roll")] == -q[index("r_shoulder_roll")]
 
 
 def test_demo_pose_holds_in_the_sim():
@@ -50,20 +67,18 @@ def test_demo_pose_holds_in_the_sim():
     assert fell == 0 and min_margin > 0.01 and abs(grip) < 2e-3 and base > 0.1 and np.isnan(fall_time)
 
 
-def test_recorded_frames_place_the_robot_where_the_sim_has_it():
+def test_recorded_frames_place_the_robot_where_the_sim_has_it(robot):
     # The recorded base pose and joints, through the NumPy kinematics (independent of rapier),
     # give the support margin and base height the Rust check measured at the end.
     X = load_demos(demos_path(heel=True)).postures
-    h = model()
     run = fall_check(X[0], X[:2], hold=0.5, record_times=[0.0, 0.3, 1.0, 5.0])
     assert run.frames.shape == (3, 9 + 19)  # 5 s is past the end: no frame
     np.testing.assert_allclose(run.frames[:, 0], [0.0, 0.3, 1.0], atol=4 / 240)
     assert not run.frames[:, 1].any()
-    end = run.link_poses(2)
-    corners = np.array([c for s in ("l_foot", "r_foot") for c in h.sole_corners(end, s)])
-    touching = corners[corners[:, 2] <= corners[:, 2].min() + 2e-3]
+    end = robot.link_poses(run.frames[2, 9:], pose_matrix(run.frames[2, 2:9]))
+    corners = np.vstack([robot.box_corners(end, s) for s in SOLES])
     assert abs(corners[:, 2].min()) < 2e-3  # on the floor
-    assert hull_margin(h.com(end)[:2], touching[:, :2]) == pytest.approx(run.segments[1, 2], abs=1e-6)
+    assert robot.support_margin(end, SOLES) == pytest.approx(run.segments[1, 2], abs=1e-6)
     assert run.frames[2, 4] == pytest.approx(run.segments[1, 5])
     np.testing.assert_allclose(run.frames[0, 9:], X[0], atol=1e-9)
 
@@ -73,7 +88,7 @@ def test_fall_check_rejects_bad_shapes():
         fall_check(np.zeros(19), np.zeros((2, 18)))
     with pytest.raises(ValueError, match="record_times: expected finite times"):
         fall_check(np.zeros(19), np.zeros((1, 19)), record_times=[float("nan")])
-    assert "humanoid_fall_check" in _native.__all__
+    assert "fall_check" in _native.__all__
 
 
 @pytest.fixture(scope="module")
@@ -114,7 +129,6 @@ def test_pca_misses_the_demos_by_degrees(table):
     assert max(r["rms_deg"] for r in pca) > 1.0
     assert max(abs(r["grip_error"]) for r in pca) > 5e-3
     assert np.isfinite([r["sim_margin"] for r in pca]).all()  # falls: reported, not asserted
-    assert GRIP_WIDTH == 0.10
 
 
 def test_fig7a_frames_agree_with_the_table(tmp_path):

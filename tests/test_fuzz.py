@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import io
 import json
+import math
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -22,18 +23,18 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 import latentrl
-from latentrl import GPLVM, PCA, _native, load_demos
+from latentrl import GPLVM, PCA, Task, _native, load_demos
 from latentrl._native import (
     GpMap,
     InternalError,
+    InvalidInputError,
     LatentrlError,
     arms_elbows,
     arms_fk,
     arms_ik,
     gplvm_nll_grad,
-    run_arms_trials,
+    run_task_trials,
 )
-from latentrl.experiments import exp2
 
 ALLOWED = (ValueError, TypeError, OSError)
 FUZZ = settings(suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -121,24 +122,31 @@ def test_exception_hierarchy() -> None:
 
 
 @pytest.mark.parametrize(
-    "call",
+    ("call", "says"),
     [
-        lambda: GpMap(np.zeros((0, 2)), np.zeros((0, 1)), np.ones(3)),
-        lambda: GpMap(np.zeros((3, 2)), np.zeros((2, 1)), np.ones(3)),
-        lambda: GpMap(np.zeros((3, 2)), np.zeros((3, 1)), np.array([1.0, -1.0, 0.0])),
-        lambda: GpMap(np.ones((3, 1)), np.ones((3, 1)), np.array([1.0, 1.0, 0.0])),
-        lambda: gplvm_nll_grad(np.zeros((3, 2)), np.zeros((3, 4)), np.array([800.0, -800.0, 800.0])),
-        lambda: gplvm_nll_grad(np.zeros((1, 1)), np.zeros((1, 1)), np.zeros(3)),
-        lambda: arms_ik(np.full((2, 4), 5.0)),
-        lambda: arms_fk(np.full((1, 4), np.nan)),
-        lambda: arms_elbows(np.zeros((3, 3))),
+        (lambda: GpMap(np.zeros((0, 2)), np.zeros((0, 1)), np.ones(3)), "inputs is empty"),
+        (lambda: GpMap(np.zeros((3, 2)), np.zeros((2, 1)), np.ones(3)), "outputs: expected shape"),
+        (lambda: GpMap(np.zeros((3, 2)), np.zeros((3, 1)), np.array([1.0, -1.0, 0.0])), "theta2"),
+        (lambda: GpMap(np.ones((3, 1)), np.ones((3, 1)), np.array([1.0, 1.0, 0.0])), "theta3"),
+        (lambda: gplvm_nll_grad(np.zeros((3, 2)), np.zeros((3, 4)), np.array([800.0, -800.0, 800.0])), "theta1"),
+        (lambda: arms_ik(np.full((2, 4), 5.0)), "unreachable"),
+        (lambda: arms_fk(np.full((1, 4), np.nan)), "non-finite"),
+        (lambda: arms_elbows(np.zeros((3, 3))), "expected shape"),
     ],
 )
-def test_known_bad_inputs_raise_value_errors_not_panics(call: Any) -> None:
-    try:
+def test_known_bad_inputs_raise_value_errors_not_panics(call: Any, says: str) -> None:
+    with pytest.raises(InvalidInputError, match=says):
         call()
-    except BaseException as err:  # noqa: BLE001 - the point is to see every exception type
-        assert isinstance(err, ALLOWED), f"{type(err).__module__}.{type(err).__name__}: {err}"
+
+
+def test_one_point_in_one_dimension_is_a_valid_gplvm_objective() -> None:
+    """N = D = q = 1 with log θ = 0 is a GP of one point (issue #22 asked for a decision): valid,
+    K = θ₁ + θ₃ = 2, so NLL = ½ log(2π · 2) + ½ · 0² / 2, against the closed form."""
+    nll, grad_z, grad_log_theta, _ = gplvm_nll_grad(np.zeros((1, 1)), np.zeros((1, 1)), np.zeros(3))
+    assert nll == pytest.approx(0.5 * math.log(4 * math.pi), rel=1e-12)
+    assert grad_z.shape == (1, 1) and grad_z[0, 0] == 0.0
+    # d NLL / d log θ₁ = d NLL / d log θ₃ = ½ θ / K = ¼ (no data term at y = 0); θ₂ has no effect.
+    np.testing.assert_allclose(grad_log_theta, [0.25, 0.0, 0.25], rtol=1e-12)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -330,9 +338,10 @@ def test_arms_fk_ik_round_trip_is_finite(postures: Any) -> None:
 
 
 # ---------------------------------------------------------------------------------------------
-# Malformed URDF robots for the Experiment 2 runner
+# Malformed URDF robots for the task runner (the two-arm task of Experiment 2)
 
-URDF = Path(exp2.urdf_path()).read_text()
+ARMS = Task.shipped("two_arms")
+URDF = ARMS.urdf_path.read_text()
 
 MUTATIONS = {
     "truncate": None,
@@ -369,6 +378,13 @@ MUTATIONS = {
 }
 
 
+def test_mutations_apply_to_the_shipped_urdf() -> None:
+    """Each mutation changes the URDF: a pattern the file no longer holds would fuzz nothing."""
+    for name, mutation in MUTATIONS.items():
+        if mutation is not None and name != "intact":
+            assert mutation[0] in URDF, name
+
+
 @pytest.fixture(scope="module")
 def arms_maps() -> dict[str, Any]:
     """A decoder latent (2) → posture (4) and an encoder back, through postures that hold the
@@ -386,9 +402,19 @@ def arms_maps() -> dict[str, Any]:
     }
 
 
+def run_arms(urdf_text: str, maps: dict[str, Any], overrides: dict[str, Any] | None = None) -> dict[str, Any]:
+    """One 3-step episode of the two-arm task with its URDF replaced by `urdf_text` and its
+    keys by `overrides` (a Task error is raised before the run)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        Path(tmp, "robot.urdf").write_text(urdf_text)
+        config = {**ARMS.to_dict(), "urdf": "robot.urdf"}
+        task = Task.from_dict(config, tmp).replace({"episode.max_steps": 3, **(overrides or {})})
+        return run_task_trials(task._native, **maps, n_trials=1, episodes=1, base_seed=0)
+
+
 def test_intact_urdf_runs(arms_maps: dict[str, Any]) -> None:
-    out = run_arms_trials(URDF, **arms_maps, n_trials=1, episodes=1, base_seed=0, config={"max_steps": 3})
-    assert all_finite(out["returns"])
+    out = run_arms(URDF, arms_maps)
+    assert all_finite(out["returns"]) and out["steps"][0, 0] >= 1
 
 
 @FUZZ
@@ -396,7 +422,7 @@ def test_intact_urdf_runs(arms_maps: dict[str, Any]) -> None:
     names=st.lists(st.sampled_from(sorted(MUTATIONS)), min_size=1, max_size=3),
     cut=st.floats(0, 1),
 )
-def test_run_arms_trials_malformed_urdf(arms_maps: dict[str, Any], names: list[str], cut: float) -> None:
+def test_task_runner_malformed_urdf(arms_maps: dict[str, Any], names: list[str], cut: float) -> None:
     text = URDF
     for name in names:
         mutation = MUTATIONS[name]
@@ -404,53 +430,47 @@ def test_run_arms_trials_malformed_urdf(arms_maps: dict[str, Any], names: list[s
             text = text[: int(cut * len(text))]
         else:
             text = text.replace(*mutation, 1)
-    out = attempt(
-        run_arms_trials,
-        text,
-        **arms_maps,
-        n_trials=1,
-        episodes=1,
-        base_seed=0,
-        config={"max_steps": 3},
-    )
+    out = attempt(run_arms, text, arms_maps)
     if out is not None:
         assert all_finite(out["returns"], out["steps"])
 
 
 # ---------------------------------------------------------------------------------------------
-# Experiment 1 runner: extreme config values
+# Extreme values of every task key and of every key of Experiment 1's toy
 
 NUMBERS = st.one_of(
     st.floats(-10, 10),
     st.sampled_from([0.0, -1.0, 1.0, 1e-300, 1e300, -1e300, np.nan, np.inf]),
     st.integers(-3, 50),
 )
-CONFIG_KEYS = {
-    "alpha": NUMBERS, "gamma": NUMBERS, "initial_weight": NUMBERS, "beta": NUMBERS,
-    "step_fraction": NUMBERS, "rbf_width": NUMBERS, "rbf_cutoff": NUMBERS,
-    "variance_threshold": st.one_of(st.none(), NUMBERS), "penalty": NUMBERS, "theta": NUMBERS,
-    "drop_tolerance": NUMBERS, "obstacle_radius": NUMBERS, "start_sd": NUMBERS,
-    "reached_rms": NUMBERS, "centres_per_dim": st.integers(-1, 400), "start": st.text(max_size=8),
-    "target": st.lists(NUMBERS, max_size=5), "grip": st.one_of(st.lists(NUMBERS, max_size=3), st.text()),
-}
+VALUES = st.one_of(
+    NUMBERS, st.lists(NUMBERS, max_size=4), st.lists(st.lists(NUMBERS, max_size=3), max_size=3),
+    st.text(max_size=8), st.none(), st.booleans(), st.dictionaries(st.text(max_size=3), NUMBERS, max_size=2),
+)
+TASK_KEYS = sorted(row["key"] for row in _native.task_schema() if "[]" not in row["key"] and "NAME" not in row["key"])
+BIMANUAL_KEYS = sorted(row["key"] for row in _native.bimanual_schema())
+
+
+@FUZZ
+@given(overrides=st.dictionaries(st.sampled_from(TASK_KEYS), VALUES, min_size=1, max_size=3))
+def test_task_runner_extreme_task_keys(arms_maps: dict[str, Any], overrides: dict[str, Any]) -> None:
+    out = attempt(run_arms, URDF, arms_maps, overrides)
+    if out is not None:
+        assert all_finite(out["returns"], out["steps"])
 
 
 @FUZZ
 @given(
-    config=st.sampled_from(sorted(CONFIG_KEYS))
-    .flatmap(lambda key: st.tuples(st.just(key), CONFIG_KEYS[key]))
-    .map(lambda item: dict([item]))
-    | st.fixed_dictionaries({}, optional=CONFIG_KEYS),
-    learner=st.sampled_from(["full", "latent", "?"]),
+    config=st.dictionaries(st.sampled_from(BIMANUAL_KEYS), VALUES, max_size=3),
+    latent=st.booleans(),
 )
-def test_run_bimanual_trials_extreme_config(
-    arms_maps: dict[str, Any], config: dict[str, Any], learner: str
-) -> None:
-    maps = {} if learner == "full" else arms_maps
-    config = {**config, "max_steps": 20}
-    out = attempt(
-        _native.run_bimanual_trials, learner, n_trials=1, episodes=2, base_seed=0, config=config, **maps
-    )
+def test_run_bimanual_trials_extreme_config(arms_maps: dict[str, Any], config: dict[str, Any], latent: bool) -> None:
+    tables: dict[str, dict[str, Any]] = {"plant": {"max_steps": 20}, "learner": {}}
+    for key, value in config.items():
+        table, name = key.split(".")
+        tables[table][name] = value if name != "max_steps" else min(value, 20) if isinstance(value, int) else value
+    maps = arms_maps if latent else {}
+    out = attempt(_native.run_bimanual_trials, n_trials=1, episodes=2, base_seed=0, **tables, **maps)
     if out is not None:
         assert all_finite(out["returns"], out["learner_low"], out["learner_high"])
 

@@ -4,16 +4,18 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from latentrl import Demonstrations, load_demos, save_demos
+from latentrl import Demonstrations, Task, load_demos, save_demos
 from latentrl._native import Sim
 from latentrl.datasets import arm_postures
-from latentrl.experiments.exp2 import JOINT_NAMES, urdf_path
-from latentrl.humanoid import demos_path, model
+from latentrl.experiments.exp3 import demos_path
 from latentrl.keyframes import interpolate_keyframes, record_postures
+
+ARMS = Task.shipped("two_arms")
+JOINT_NAMES = ARMS.joint_names
 
 
 def test_interpolation_joins_consecutive_keyframes_within_each_sequence():
-    keys = load_demos(demos_path(), expected_joints=model().joint_names)
+    keys = load_demos(demos_path(), expected_joints=Task.shipped("humanoid_lift").joint_names)
     dense = interpolate_keyframes(keys, 4, breaks=(4,))
     X, Y = keys.postures, dense.postures
     assert Y.shape == (4 * 3 + 1 + 4 * 2 + 1, 19) and dense.joint_names == keys.joint_names
@@ -34,7 +36,7 @@ def test_interpolation_rejects_bad_arguments():
 
 
 def test_recorded_postures_reach_each_held_target_and_save(tmp_path):
-    sim = Sim(urdf_path(), solver_iterations=2)
+    sim = Sim(ARMS.urdf_path, physics={"solver_iterations": 2})
     targets = arm_postures(3, np.random.default_rng(2))
     sim.reset(targets[0])
     demos = record_postures(sim, targets, hold_steps=60, every=6)
@@ -58,4 +60,4 @@ def test_recorded_postures_reach_each_held_target_and_save(tmp_path):
 )
 def test_record_rejects_bad_arguments(targets, kwargs, message):
     with pytest.raises(ValueError, match=message):
-        record_postures(Sim(urdf_path()), targets, **kwargs)
+        record_postures(Sim(ARMS.urdf_path), targets, **kwargs)

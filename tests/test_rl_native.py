@@ -23,37 +23,38 @@ def maps():
 
 
 def small(**overrides):
-    kwargs = dict(n_trials=2, episodes=5, base_seed=0, config={"max_steps": 20})
+    kwargs = dict(n_trials=2, episodes=5, base_seed=0, plant={"max_steps": 20})
     kwargs.update(overrides)
     return kwargs
 
 
 @pytest.mark.parametrize(
-    ("learner", "kwargs", "message"),
+    ("kwargs", "message"),
     [
-        ("sideways", {}, 'learner: expected "full" or "latent"'),
-        ("full", {"n_trials": 0}, r"n_trials must lie in \[1,"),
-        ("full", {"episodes": -3}, r"episodes must lie in \[1,"),
-        ("full", {"episodes": 2.5}, "episodes: expected an int"),
-        ("full", {"base_seed": -1}, r"base_seed must lie in \[0,"),
-        ("full", {"config": {"alpah": 0.5}}, 'unknown key "alpah"'),
-        ("full", {"config": {"alpha": -1.0}}, "alpha"),
-        ("full", {"config": {"gamma": 2.0}}, "gamma"),
-        ("full", {"config": {"beta": float("nan")}}, "must be finite"),
-        ("full", {"config": {"target": [0.0, 0.0]}}, "expected 4 numbers"),
-        ("full", {"config": {"drop_tolerance": 0.0}}, "drop_tolerance"),
-        ("full", {"config": {"max_steps": 0}}, "max_steps"),
-        ("full", {"config": {"start": "anywhere"}}, 'config\\["start"\\]'),
-        ("full", {"config": [("alpha", 0.5)]}, "config: expected a dict"),
-        ("full", {"record_episodes": [0, 5]}, r"record_episodes\[i\] must lie in \[0, 4\]"),
-        ("full", {"progress": 3}, "progress: expected a callable"),
-        ("full", {"latent_low": LOW}, 'learner="full" takes no decoder'),
-        ("latent", {}, "decoder .* is required"),
+        ({"n_trials": 0}, r"n_trials must lie in \[1,"),
+        ({"episodes": -3}, r"episodes must lie in \[1,"),
+        ({"episodes": 2.5}, "episodes: expected an int"),
+        ({"base_seed": -1}, r"base_seed must lie in \[0,"),
+        ({"learner": {"alpah": 0.5}}, "learner: alpah: unknown field `alpah`, expected one of `rbf_per_dim`"),
+        ({"learner": {"alpha": -1.0}}, r"learner.alpha must lie in \(0, 1\], got -1"),
+        ({"learner": {"gamma": 2.0}}, r"learner.gamma must lie in \[0, 1\), got 2"),
+        ({"learner": {"beta": float("nan")}}, "learner.beta must be a finite number > 0, got NaN"),
+        ({"plant": {"target": [0.0, 0.0]}}, "plant: target: invalid length 2, expected an array of length 4"),
+        ({"plant": {"drop_tolerance": 0.0}}, "plant.drop_tolerance must be a finite number > 0, got 0"),
+        ({"plant": {"max_steps": 0}}, r"plant.max_steps must be an integer in \[1, 1000000\], got 0"),
+        ({"plant": {"box_high": -1.0}}, "box_high must exceed box_low"),
+        ({"learner": [("alpha", 0.5)]}, "learner: expected a dict of keys, got list"),
+        ({"record_episodes": [0, 5]}, r"record_episodes\[i\] must lie in \[0, 4\]"),
+        ({"progress": 3}, "progress: expected a callable"),
+        ({"latent_low": LOW}, "decoder .* is required"),
+        ({"episodes": 10**7, "n_trials": 10}, "episode records in one call, more than 10000000"),
+        ({"record_episodes": list(range(5)), "plant": {"max_steps": 10**6}, "n_trials": 1000},
+         r"needs .* values, more than 268435456 \(2 GiB\)"),
     ],
 )
-def test_bad_inputs_raise_invalid_input(learner, kwargs, message):
+def test_bad_inputs_raise_invalid_input(kwargs, message):
     with pytest.raises(InvalidInputError, match=message):
-        run_bimanual_trials(learner, **small(**kwargs))
+        run_bimanual_trials(**small(**kwargs))
 
 
 def test_bad_latent_inputs(maps):
@@ -71,13 +72,13 @@ def test_bad_latent_inputs(maps):
     ]
     for kwargs, message in cases:
         with pytest.raises(InvalidInputError, match=message):
-            run_bimanual_trials("latent", **small(**kwargs))
+            run_bimanual_trials(**small(**kwargs))
 
 
 def test_same_seed_same_arrays_and_shapes():
     kwargs = small(n_trials=3, episodes=8, base_seed=11, record_episodes=[0, 7], return_weights=True)
-    a = run_bimanual_trials("full", **kwargs)
-    b = run_bimanual_trials("full", **kwargs)
+    a = run_bimanual_trials(**kwargs)
+    b = run_bimanual_trials(**kwargs)
     for key in ("returns", "ends", "steps", "reached", "finished", "trials", "trajectories", "weights"):
         np.testing.assert_array_equal(a[key], b[key], err_msg=key)
     assert a["returns"].shape == (3, 8) and a["returns"].dtype == np.float64
@@ -91,12 +92,12 @@ def test_same_seed_same_arrays_and_shapes():
     rows = int(np.isfinite(traj[:, 0]).sum())
     assert np.isfinite(traj[:rows]).all() and np.isnan(traj[rows:]).all()
     np.testing.assert_allclose(traj[0, 2:] - traj[0, :2], [0.1, 0.0], atol=1e-12)
-    c = run_bimanual_trials("full", **dict(kwargs, base_seed=12))
+    c = run_bimanual_trials(**dict(kwargs, base_seed=12))
     assert not np.array_equal(a["returns"], c["returns"])
     # A resumed sweep reproduces trial 2 exactly.
-    d = run_bimanual_trials("full", **dict(kwargs, n_trials=1, first_trial=2))
+    d = run_bimanual_trials(**dict(kwargs, n_trials=1, first_trial=2))
     np.testing.assert_array_equal(d["returns"][0], a["returns"][2])
-    assert a["config"]["alpha"] == 0.9 and a["config"]["max_steps"] == 20
+    assert a["learner"]["alpha"] == 0.9 and a["plant"]["max_steps"] == 20
 
 
 def test_full_space_learner_learns_with_forgiving_tolerance():
@@ -108,11 +109,11 @@ def test_full_space_learner_learns_with_forgiving_tolerance():
     late = {}
     for name, alpha in (("learner", 0.9), ("control", CONTROL_ALPHA)):
         out = run_bimanual_trials(
-            "full",
             n_trials=2,
             episodes=300,
             base_seed=1,
-            config={"drop_tolerance": 0.1, "max_steps": 200, "alpha": alpha},
+            plant={"drop_tolerance": 0.1, "max_steps": 200},
+            learner={"alpha": alpha},
             progress=lambda done, total: calls.append((done, total)),
         )
         late[name] = out["returns"][:, -50:].mean(axis=1)
@@ -123,11 +124,10 @@ def test_full_space_learner_learns_with_forgiving_tolerance():
 def test_latent_learner_runs_and_never_drops(maps):
     decoder, encoder = maps
     out = run_bimanual_trials(
-        "latent",
         n_trials=2,
         episodes=100,
         base_seed=3,
-        config={"drop_tolerance": 0.005, "max_steps": 200},
+        plant={"drop_tolerance": 0.005, "max_steps": 200},
         decoder=decoder,
         encoder=encoder,
         latent_low=list(LOW),  # any 1-D sequence of numbers
@@ -147,4 +147,4 @@ def test_progress_exception_propagates():
         raise RuntimeError("stop here")
 
     with pytest.raises(RuntimeError, match="stop here"):
-        run_bimanual_trials("full", n_trials=2, episodes=100_000, base_seed=0, progress=boom)
+        run_bimanual_trials(n_trials=2, episodes=100_000, base_seed=0, progress=boom)

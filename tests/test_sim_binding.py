@@ -5,17 +5,31 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from latentrl import InvalidInputError
+from latentrl import InvalidInputError, Task
 from latentrl._native import Sim, arms_ik
 from latentrl.datasets import arms_forward
-from latentrl.envs import arms_urdf
+from urdf_reference import task_robot
 
 START = arms_ik(np.array([[-0.25, 0.15, -0.15, 0.15]]))[0]
+ARMS = Task.shipped("two_arms")
+LIFT = Task.shipped("humanoid_lift")
+
+
+def urdf(task: Task) -> str:
+    """Path of the task's URDF."""
+    return str(task.urdf_path)
+
+
+def world(task: Task, **kwargs) -> dict:
+    """The `Sim` keywords of the task's world: root, floor, physics and servos."""
+    config = task.to_dict()
+    floor = config["floor"]["height"] if config["floor"] is not None else None
+    return {"root": config["root"], "floor": floor, "physics": config["physics"], "servo": config["servo"], **kwargs}
 
 
 @pytest.fixture
 def sim() -> Sim:
-    s = Sim(arms_urdf(), solver_iterations=2)
+    s = Sim(urdf(ARMS), **world(ARMS))
     s.reset(START)
     return s
 
@@ -25,8 +39,8 @@ def hands(s: Sim) -> np.ndarray:
 
 
 def test_builds_from_path_or_xml():
-    from_path = Sim(Path(arms_urdf()))
-    from_xml = Sim(Path(arms_urdf()).read_text(), dt=1 / 480, substeps=24)
+    from_path = Sim(Path(urdf(ARMS)))
+    from_xml = Sim(Path(urdf(ARMS)).read_text(), physics={"dt": 1 / 480, "substeps": 24})
     assert from_path.joint_names == ["left_shoulder", "left_elbow", "right_shoulder", "right_elbow"]
     assert from_xml.joint_names == from_path.joint_names
     assert from_path.dt == pytest.approx(0.05) and from_xml.dt == pytest.approx(0.05)
@@ -87,17 +101,23 @@ def test_bad_inputs_raise_clear_errors(sim):
     with pytest.raises(InvalidInputError, match="n: expected an int >= 0"):
         sim.step(-1)
     with pytest.raises(InvalidInputError, match="root"):
-        Sim(arms_urdf(), root="loose")  # type: ignore[arg-type]
-    with pytest.raises(InvalidInputError, match="substeps"):
-        Sim(arms_urdf(), substeps=0)
-    with pytest.raises(InvalidInputError, match="pgs_iterations: expected an int > 0, got 0"):
-        Sim(arms_urdf(), pgs_iterations=0)
-    with pytest.raises(InvalidInputError, match="dt"):
-        Sim(arms_urdf(), dt=-1.0)
-    with pytest.raises(InvalidInputError, match="kp|<any>"):
-        Sim(arms_urdf(), kp=-5.0)
-    with pytest.raises(InvalidInputError, match="gravity"):
-        Sim(arms_urdf(), gravity=np.zeros(2))
+        Sim(urdf(ARMS), root="loose")  # type: ignore[arg-type]
+    with pytest.raises(InvalidInputError, match=r"physics.substeps must be an integer in \[1, 10000\], got 0"):
+        Sim(urdf(ARMS), physics={"substeps": 0})
+    with pytest.raises(InvalidInputError, match=r"physics.pgs_iterations must be an integer in \[1, 1000\], got 0"):
+        Sim(urdf(ARMS), physics={"pgs_iterations": 0})
+    with pytest.raises(InvalidInputError, match=r"physics.dt must lie in \(0, 0.05\], got -1"):
+        Sim(urdf(ARMS), physics={"dt": -1.0})
+    with pytest.raises(InvalidInputError, match="servo.kp must be a finite number >= 0, got -5"):
+        Sim(urdf(ARMS), servo={"kp": -5.0})
+    with pytest.raises(InvalidInputError, match="physics: gravity: invalid length 2, expected an array of length 3"):
+        Sim(urdf(ARMS), physics={"gravity": [0.0, 0.0]})
+    with pytest.raises(InvalidInputError, match="unknown field `dtt`"):
+        Sim(urdf(ARMS), physics={"dtt": 0.01})
+    with pytest.raises(InvalidInputError, match="unknown field `gain`"):
+        Sim(urdf(ARMS), servo={"gain": 1.0})
+    with pytest.raises(TypeError, match="dt"):  # the world's keys are in physics= and servo=
+        Sim(urdf(ARMS), dt=0.01)  # type: ignore[call-arg]
     with pytest.raises(InvalidInputError):
         Sim("/no/such/robot.urdf")
     with pytest.raises(InvalidInputError):
@@ -105,15 +125,14 @@ def test_bad_inputs_raise_clear_errors(sim):
 
 
 def test_floating_humanoid_stands_on_the_ground_and_falls_without_it():
-    from latentrl.humanoid import PHYSICS, SERVO, model, urdf_path
-
-    kin = model()
+    kin = task_robot(LIFT)  # the NumPy reference kinematics of the URDF
     home = np.zeros(len(kin.joint_names))
     poses = kin.link_poses(home)  # Sim.reset leaves the floating base at the identity
-    sole = min(c[2] for s in ("l_foot", "r_foot") for c in kin.sole_corners(poses, s))
+    sole = min(kin.box_corners(poses, s)[:, 2].min() for s in ("l_foot", "r_foot"))
     heights = {}
     for ground in (sole - 5e-4, None):
-        s = Sim(urdf_path(), root="floating", substeps=24, ground=ground, **SERVO, **PHYSICS)
+        config = world(LIFT, floor=ground)
+        s = Sim(urdf(LIFT), **{**config, "physics": {**config["physics"], "substeps": 24}})
         s.reset(home)
         start = s.frame_position("torso")[2]
         for _ in range(10):  # 1 s
@@ -125,22 +144,20 @@ def test_floating_humanoid_stands_on_the_ground_and_falls_without_it():
     assert end < start - 1.0  # free fall for 1 s: ~4.9 m
 
 
-def test_ground_must_be_finite():
-    with pytest.raises(InvalidInputError, match="ground"):
-        Sim(arms_urdf(), ground=float("nan"))
+def test_floor_must_be_finite():
+    with pytest.raises(InvalidInputError, match="floor must be a finite height"):
+        Sim(urdf(ARMS), floor=float("nan"))
 
 
 def test_reset_on_ground_and_fall_status_check_their_inputs():
-    from latentrl import humanoid
-
-    floating = Sim(str(humanoid.urdf_path()), root="floating", ground=0.0)
+    floating = Sim(urdf(LIFT), root="floating", floor=0.0)
     home = np.zeros(len(floating.joint_names))
     floating.reset_on_ground(home, "l_foot")
     fell, height, tilt, contact = floating.fall_status(["l_foot", "r_foot"], min_base_height=0.05)
     assert not fell and height == pytest.approx(floating.base_position()[2]) and tilt < 1e-6 and contact is None
     assert floating.fall_status(["l_foot", "r_foot"], min_base_height=1.0)[0]  # base below 1 m: fallen
     with pytest.raises(InvalidInputError, match="no floor"):
-        Sim(str(humanoid.urdf_path()), root="floating").reset_on_ground(home, "l_foot")
+        Sim(urdf(LIFT), root="floating").reset_on_ground(home, "l_foot")
     with pytest.raises(ValueError, match="l_paw"):
         floating.reset_on_ground(home, "l_paw")
     with pytest.raises(ValueError, match="clearance"):

@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 
 from latentrl.cli import main
-from latentrl.experiments.exp1 import Exp1Preset, run_exp1
+from latentrl.experiments.exp1 import Exp1Preset
+from latentrl.experiments.registry import run_experiment
 from latentrl.experiments.sweep import Sweep, SweepError, load_sweep, run_sweep
 from latentrl.experiments.sweep_summary import episodes_to_threshold
 
@@ -23,17 +24,17 @@ from latentrl.experiments.sweep_summary import episodes_to_threshold
 os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweep.toml"
-TINY = {"episodes": 20, "steps": 50, "gplvm_max_iter": 100}
-SWEEP = Sweep("exp1", quick=True, trials=2, base=TINY, grid={"beta": [5.0, 10.0]})
+TINY = {"episodes": 20, "plant.max_steps": 50, "gplvm_max_iter": 100}
+SWEEP = Sweep("exp1", quick=True, trials=2, base=TINY, grid={"learner.beta": [5.0, 10.0]})
 SWEEP_TOML = """
 experiment = "exp1"
 quick = true
 trials = 2
 [base]
 episodes = 20
-steps = 50
 gplvm_max_iter = 100
-[grid]
+plant.max_steps = 50
+[grid.learner]
 beta = [5, 10.0]
 """
 
@@ -81,21 +82,21 @@ def test_toml_file_gives_the_python_sweep(tmp_path):
         ('experiment = "table1"', "unknown experiment 'table1'"),
         ("quick = true", "no experiment"),
         ('experiment = "exp1"\ntrails = 3', "unknown key 'trails'"),
-        ('experiment = "exp1"\n[grid]\nbetaa = [1.0]', "grid.betaa: 'betaa' is not a field of the preset; did you mean 'beta'"),
+        ('experiment = "exp1"\n[grid]\n"learner.betaa" = [1.0]', "grid.learner.betaa: 'learner.betaa' is not a field of the preset or a task key; did you mean 'learner.beta'"),
         ('experiment = "exp1"\n[base]\nno_such = 1', "base.no_such: 'no_such' is not a field"),
-        ('experiment = "exp1"\n[grid]\nbeta = []', "grid.beta: empty list"),
-        ('experiment = "exp1"\n[grid]\nbeta = 5.0', "grid.beta: expected a list of values, got 5.0"),
-        ('experiment = "exp1"\n[grid]\nbeta = [5.0, 5]', "grid.beta: 5.0 appears twice"),
+        ('experiment = "exp1"\n[grid.learner]\nbeta = []', "grid.learner.beta: empty list"),
+        ('experiment = "exp1"\n[grid.learner]\nbeta = 5.0', "grid.learner.beta: expected a list of values, got 5.0"),
+        ('experiment = "exp1"\n[grid.learner]\nbeta = [5.0, 5]', "grid.learner.beta: 5.0 appears twice"),
         ('experiment = "exp1"\n[grid]\nepisodes = [10, 2.5]', r"grid.episodes\[1\]: expected an integer, got 2.5"),
-        ('experiment = "exp1"\n[grid]\nbeta = ["hot"]', r"grid.beta\[0\]: expected a number, got 'hot'"),
+        ('experiment = "exp1"\n[grid.learner]\nbeta = ["hot"]', r"grid.learner.beta\[0\]: expected a number, got 'hot'"),
         ('experiment = "exp1"\n[base]\nepisodes = true', "base.episodes: expected an integer, got True"),
         ('experiment = "exp1"\ntrials = 0', "trials: must be >= 1, got 0"),
         ('experiment = "exp1"\nquick = "yes"', "quick: expected true or false"),
         ('experiment = "exp1"\ntrials = 2\n[base]\ntrials = 3', "base.trials: trials is already set"),
-        ('experiment = "exp1"\n[base]\ngamma = 1.5', r"cell 00: gamma must lie in \[0, 1\)"),
+        ('experiment = "exp1"\n[base.learner]\ngamma = 1.5', r"cell 00: learner.gamma must lie in \[0, 1\)"),
         ('experiment = "exp1"\ncells = 3', "cells: expected a list of tables"),
-        ('experiment = "exp1"\n[grid]\nbeta = [1.0]\n[[cells]]\nbeta = 2.0', r"cells\[0\]: beta also in the grid"),
-        ('experiment = "exp1"\n[[cells]]\nbeta = 2.0\n[[cells]]\nbeta = 2', "cells 00_beta=2.0 and 01_beta=2.0 are the same"),
+        ('experiment = "exp1"\n[grid.learner]\nbeta = [1.0]\n[[cells]]\n"learner.beta" = 2.0', r"cells\[0\]: learner.beta also in the grid"),
+        ('experiment = "exp1"\n[[cells]]\nlearner.beta = 2.0\n[[cells]]\nlearner.beta = 2', "cells 00_learner.beta=2.0 and 01_learner.beta=2.0 are the same"),
         ('experiment = "exp1"\n[grid\n', "not valid TOML"),
     ],
 )
@@ -108,24 +109,26 @@ def test_bad_descriptions_are_value_errors_naming_the_problem(tmp_path, text, me
 
 def test_yaml_file_when_pyyaml_is_there(tmp_path):
     pytest.importorskip("yaml")
-    text = "experiment: exp1\nquick: true\ntrials: 2\nbase: {episodes: 20, steps: 50, gplvm_max_iter: 100}\n"
-    assert load_sweep(write(tmp_path, text + "grid: {beta: [5, 10.0]}\n", "s.yaml")) == SWEEP
+    text = "experiment: exp1\nquick: true\ntrials: 2\nbase: {episodes: 20, plant.max_steps: 50, gplvm_max_iter: 100}\n"
+    assert load_sweep(write(tmp_path, text + "grid: {learner: {beta: [5, 10.0]}}\n", "s.yaml")) == SWEEP
 
 
 def test_cells_are_the_explicit_cells_crossed_with_the_grid():
     sweep = Sweep(
-        "exp1", trials=4, seed=7, base={"episodes": 30, "beta": 3.0},
-        grid={"alpha": [0.5, 0.9], "gamma": [0.9, 0.95]}, cells=[{"beta": 1}, {"steps": 80}],
+        "exp1", trials=4, seed=7, base={"episodes": 30, "learner.beta": 3.0},
+        grid={"learner": {"alpha": [0.5, 0.9], "gamma": [0.9, 0.95]}}, cells=[{"learner.beta": 1}, {"plant.max_steps": 80}],
     )
     cells = sweep.expand()
     assert [c.overrides for c in cells[:4]] == [
-        {"beta": 1.0, "alpha": a, "gamma": g} for a in (0.5, 0.9) for g in (0.9, 0.95)
+        {"learner.beta": 1.0, "learner.alpha": a, "learner.gamma": g} for a in (0.5, 0.9) for g in (0.9, 0.95)
     ]
-    assert len(cells) == 8 and cells[4].overrides == {"steps": 80, "alpha": 0.5, "gamma": 0.9}
-    assert cells[0].id == "00_alpha=0.5_gamma=0.9_beta=1.0" and cells[7].id == "07_alpha=0.9_gamma=0.95_steps=80"
-    expected = dataclasses.replace(Exp1Preset(), trials=4, seed=7, episodes=30, beta=1.0, alpha=0.5, gamma=0.9)
-    assert cells[0].preset == expected and isinstance(cells[0].preset.beta, float)
-    assert cells[4].preset.beta == 3.0 and cells[4].preset.steps == 80  # base where no cell overrides it
+    assert len(cells) == 8 and cells[4].overrides == {"plant.max_steps": 80, "learner.alpha": 0.5, "learner.gamma": 0.9}
+    assert cells[0].id == "00_learner.alpha=0.5_learner.gamma=0.9_learner.beta=1.0"
+    assert cells[7].id == "07_learner.alpha=0.9_learner.gamma=0.95_plant.max_steps=80"
+    expected = dataclasses.replace(Exp1Preset(), trials=4, seed=7, episodes=30,
+                                   task={"learner.beta": 1.0, "learner.alpha": 0.5, "learner.gamma": 0.9})
+    assert cells[0].preset == expected and isinstance(cells[0].preset.task["learner.beta"], float)
+    assert cells[4].preset.task["learner.beta"] == 3.0 and cells[4].preset.task["plant.max_steps"] == 80
     assert len(Sweep("exp2").expand()) == 1 and Sweep("exp2").expand()[0].id == "00"
 
 
@@ -153,7 +156,7 @@ def local_run(tmp_path_factory):
 def test_local_backend_equals_running_each_cell_preset(local_run, tmp_path):
     out, state = local_run
     for cell in SWEEP.expand():
-        run_exp1(cell.preset, tmp_path / cell.id, progress=False)
+        run_experiment("exp1", cell.preset, tmp_path / cell.id, progress=False)
         assert_same_results(out / cell.id, tmp_path / cell.id)
         assert (out / cell.id / "fig4a.png").exists()
     assert [c["status"] for c in state["cells"]] == ["done", "done"]
@@ -174,7 +177,7 @@ def test_summary_has_a_row_per_cell_and_learner(local_run):
     best = max(r["final_return_mean"] for r in summary["rows"])
     assert summary["threshold"] == pytest.approx(best / 2) and summary == state["summary"]
     table = (out / "summary.md").read_text()
-    assert "| 00_beta=5.0 | 5.0 | latent | 2/2 |" in table and (out / "sweep.png").stat().st_size > 1000
+    assert "| 00_learner.beta=5.0 | 5.0 | latent | 2/2 |" in table and (out / "sweep.png").stat().st_size > 1000
 
 
 def test_a_sweep_directory_is_resumed_only_when_asked_and_only_by_the_same_sweep(local_run):
@@ -183,9 +186,9 @@ def test_a_sweep_directory_is_resumed_only_when_asked_and_only_by_the_same_sweep
         run_sweep(SWEEP, out, progress=False)
     with pytest.raises(ValueError, match="holds a different sweep"):
         run_sweep(dataclasses.replace(SWEEP, seed=3), out, resume=True, progress=False)
-    before = (out / "00_beta=5.0" / "returns.npz").stat().st_mtime_ns
+    before = (out / "00_learner.beta=5.0" / "returns.npz").stat().st_mtime_ns
     state = run_sweep(SWEEP, out, resume=True, progress=False)  # nothing left to run
-    assert (out / "00_beta=5.0" / "returns.npz").stat().st_mtime_ns == before
+    assert (out / "00_learner.beta=5.0" / "returns.npz").stat().st_mtime_ns == before
     assert len(state["runs"]) == 2
 
 
@@ -205,12 +208,12 @@ def test_ray_backend_equals_the_local_backend_bit_for_bit(ray_instance, local_ru
     # Through the CLI: `--backend ray` without --address uses the Ray that is running.
     out = tmp_path / "out"
     assert main(["sweep", str(write(tmp_path, SWEEP_TOML)), "--backend", "ray", "--no-progress", "--out", str(out)]) == 0
-    assert "| 01_beta=10.0 | 10.0 | full | 2/2 |" in capsys.readouterr().out
+    assert "| 01_learner.beta=10.0 | 10.0 | full | 2/2 |" in capsys.readouterr().out
     assert_same_sweep(local_run[0], out)
     state = json.loads((out / "sweep.json").read_text())
     assert [c["status"] for c in state["cells"]] == ["done", "done"]
     assert state["runs"][0]["backend"] == "ray" and ray_instance.is_initialized()  # not ours to stop
-    assert (out / "01_beta=10.0" / "fig4a.png").exists()
+    assert (out / "01_learner.beta=10.0" / "fig4a.png").exists()
     assert json.loads((out / "summary.json").read_text()) == json.loads((local_run[0] / "summary.json").read_text())
 
 
@@ -244,21 +247,21 @@ def test_a_failed_trial_fails_its_cell_and_resume_runs_only_that_trial(ray_insta
     def failing(experiment, preset, fingerprint, learner, first, n):
         from latentrl.experiments.ray_backend import run_chunk
 
-        if preset.beta == 10.0 and learner == "full" and first == 1:
+        if preset.task["learner.beta"] == 10.0 and learner == "full" and first == 1:
             raise RuntimeError("injected failure")
         return run_chunk(experiment, preset, fingerprint, learner, first, n)
 
     def counting(experiment, preset, fingerprint, learner, first, n):
         from latentrl.experiments.ray_backend import run_chunk
 
-        (ran / f"{preset.beta}-{learner}-{first}-{n}").touch()
+        (ran / f"{preset.task['learner.beta']}-{learner}-{first}-{n}").touch()
         return run_chunk(experiment, preset, fingerprint, learner, first, n)
 
     with pytest.raises(SweepError, match="1 of 2 cells failed.*full trials 1..1: RuntimeError: injected failure"):
         run_sweep(SWEEP, out, backend=RayBackend(task=failing), progress=False)
     cells = json.loads((out / "sweep.json").read_text())["cells"]
     assert [(c["status"], c["trials_done"]) for c in cells] == [("done", 4), ("failed", 3)]
-    with np.load(out / "01_beta=10.0" / "returns.npz") as npz:
+    with np.load(out / "01_learner.beta=10.0" / "returns.npz") as npz:
         assert (npz["full_end"][1] == -1).all() and (npz["full_end"][0] >= 0).all()
     run_sweep(SWEEP, out, backend=RayBackend(task=counting), resume=True, progress=False)
     assert sorted(p.name for p in ran.iterdir()) == ["10.0-full-1-1"]
@@ -278,7 +281,7 @@ def test_the_documented_example_runs(tmp_path, backend):
     )
     assert result.returncode == 0, result.stderr
     cells = json.loads((out / "sweep.json").read_text())["cells"]
-    assert [c["status"] for c in cells] == ["done"] * 4 and "| 03_initial_weight=20.0_beta=10.0 |" in result.stdout
+    assert [c["status"] for c in cells] == ["done"] * 4 and "| 03_learner.initial_weight=20.0_learner.beta=10.0 |" in result.stdout
 
 
 def test_the_package_never_imports_ray_itself():
@@ -288,9 +291,9 @@ def test_the_package_never_imports_ray_itself():
 
 
 def test_cli_errors_exit_1_with_the_message(tmp_path, capsys):
-    bad = write(tmp_path, 'experiment = "exp1"\n[grid]\nbeta = []')
+    bad = write(tmp_path, 'experiment = "exp1"\n[grid.learner]\nbeta = []')
     assert main(["sweep", str(bad), "--out", str(tmp_path / "a")]) == 1
-    assert "grid.beta: empty list" in capsys.readouterr().err
+    assert "grid.learner.beta: empty list" in capsys.readouterr().err
     good = write(tmp_path, SWEEP_TOML, "good.toml")
     assert main(["sweep", str(good), "--address", "auto", "--out", str(tmp_path / "b")]) == 1
     assert "--address and --batch are options of --backend ray" in capsys.readouterr().err
@@ -305,7 +308,7 @@ def test_cli_sweep_stopped_by_ctrl_c_exits_130_and_resumes(local_run, tmp_path):
     proc = subprocess.Popen([sys.executable, "-c", child, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, env={**os.environ, "RAYON_NUM_THREADS": "1"})
     deadline = time.monotonic() + 120
-    while not (out / "00_beta=5.0" / "returns.npz").exists() and time.monotonic() < deadline:
+    while not (out / "00_learner.beta=5.0" / "returns.npz").exists() and time.monotonic() < deadline:
         time.sleep(0.05)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)

@@ -7,9 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from latentrl import GPLVM, PCA, _native
+from latentrl import GPLVM, PCA, LatentPolicy, Task, _reference
 from latentrl.datasets import arm_postures
-from latentrl.experiments import exp2
 from latentrl.train import train_latent_policy
 
 README = Path(__file__).resolve().parents[1] / "README.md"
@@ -37,11 +36,7 @@ def test_readme_tutorial_learns(
     assert policy.test_returns.shape == (2, 50) and policy.test_reached.mean() > 0.5  # type: ignore[attr-defined]
     assert scope["values"].shape == (123,)  # type: ignore[attr-defined]
     assert (tmp_path / "postures.csv").is_file()
-
-
-def test_joint_names_are_the_urdf_ones() -> None:
-    sim = _native.Sim(exp2.urdf_path())
-    assert tuple(sim.joint_names) == exp2.JOINT_NAMES
+    assert scope["target"].shape == (4,) and np.isfinite(scope["target"]).all()  # type: ignore[attr-defined]
 
 
 @pytest.fixture(scope="module")
@@ -50,7 +45,8 @@ def arms_model() -> GPLVM:
 
 
 def test_same_seed_same_policy_and_value_matches_weights(arms_model: GPLVM) -> None:
-    runs = [train_latent_policy(arms_model, trials=2, episodes=3, steps=50, test_episodes=0, seed=s) for s in (4, 4, 5)]
+    runs = [train_latent_policy(arms_model, trials=2, episodes=3, overrides={"episode.max_steps": 50}, test_episodes=0, seed=s)
+            for s in (4, 4, 5)]
     np.testing.assert_array_equal(runs[0].returns, runs[1].returns)
     np.testing.assert_array_equal(runs[0].weights, runs[1].weights)
     assert not np.array_equal(runs[0].returns, runs[2].returns)
@@ -61,31 +57,80 @@ def test_same_seed_same_policy_and_value_matches_weights(arms_model: GPLVM) -> N
     assert policy.value(arms_model.Z_, trial=1).shape == (40,)
     with pytest.raises(ValueError, match=r"z must have shape \(M, 2\)"):
         policy.value(np.zeros(2))
-    with pytest.raises(ValueError, match="trial must be in 0..1"):
+    with pytest.raises(ValueError, match=r"trial must be an int in 0..1"):
         policy.value(arms_model.Z_, trial=2)
+    np.testing.assert_allclose(
+        policy.value(arms_model.Z_, trial=1),
+        _reference.value_function(policy.weights[1], policy.latent_low, policy.latent_high, arms_model.Z_),
+        rtol=1e-12, atol=1e-12,
+    )
+
+
+def test_a_saved_policy_loads_acts_and_rolls_out_the_same(arms_model: GPLVM, tmp_path: Path) -> None:
+    policy = train_latent_policy(arms_model, trials=2, episodes=5, overrides={"episode.max_steps": 30}, test_episodes=0)
+    policy.save(tmp_path / "policy.npz")
+    loaded = LatentPolicy.load(tmp_path / "policy.npz")
+    np.testing.assert_array_equal(loaded.weights, policy.weights)
+    np.testing.assert_array_equal(loaded.returns, policy.returns)
+    posture = arms_model.X_train_[3]
+    np.testing.assert_array_equal(loaded.act(posture, trial=1), policy.act(posture, trial=1))
+    once, again = policy.rollout(4, seed=2), loaded.rollout(4, seed=2)
+    np.testing.assert_array_equal(once["returns"], again["returns"])
+    assert once["returns"].shape == (2, 4) and 0.0 <= once["summary"]["reached"] <= 1.0
+    assert sum(once["summary"]["ends"].values()) == 8
+    # The greedy step: act() moves the encoded posture by one action and decodes it.
+    target = policy.act(posture)
+    assert target.shape == (4,) and np.isfinite(target).all()
+    with pytest.raises(ValueError, match=r"posture: expected shape \(4,\), got \(3,\)"):
+        policy.act(posture[:3])
+
+
+def test_a_policy_file_is_checked(arms_model: GPLVM, tmp_path: Path) -> None:
+    policy = train_latent_policy(arms_model, trials=1, episodes=2, overrides={"episode.max_steps": 10}, test_episodes=0)
+    policy.save(tmp_path / "policy.npz")
+    arms_model.save(tmp_path / "model.npz")
+    with pytest.raises(ValueError, match="holds latentrl.GPLVM, expected latentrl.LatentPolicy"):
+        LatentPolicy.load(tmp_path / "model.npz")
+    (tmp_path / "junk.npz").write_bytes(b"not a zip")
+    with pytest.raises(ValueError, match="junk.npz"):
+        LatentPolicy.load(tmp_path / "junk.npz")
+    arrays = dict(np.load(tmp_path / "policy.npz"))
+    arrays["task"] = np.array(str(arrays["task"]).replace('"beta": 20.0', '"beta": 5.0'))
+    np.savez(tmp_path / "edited.npz", **arrays)
+    with pytest.raises(ValueError, match="its task .* changed since it was saved"):
+        LatentPolicy.load(tmp_path / "edited.npz")
 
 
 def test_humanoid_task_runs() -> None:
     from latentrl.experiments.exp3 import Exp3Preset, fit
 
     model = fit(Exp3Preset.quick()).model
-    policy = train_latent_policy(model, "humanoid_lift", trials=1, episodes=2, steps=10, test_episodes=0)
+    policy = train_latent_policy(model, "humanoid_lift", trials=1, episodes=2, overrides={"episode.max_steps": 10},
+                                 test_episodes=0)
     assert policy.returns.shape == (1, 2)
     assert np.isfinite(policy.returns).all()
     assert policy.weights.shape == (1, 400)
     few = GPLVM(n_components=2, max_iter=20, random_state=0).fit(model.X_train_[:5])
-    with pytest.raises(ValueError, match="start_demo=6 is not a row of the model's 5 postures"):
-        train_latent_policy(few, "humanoid_lift", start_demo=6)
+    with pytest.raises(ValueError, match="episode.start_demo = 6 is not a row of the 5 demonstrations"):
+        train_latent_policy(few, "humanoid_lift", overrides={"episode.start_demo": 6})
+
+
+def test_a_task_of_ones_own_trains(arms_model: GPLVM) -> None:
+    task = Task.from_dict({**Task.shipped("two_arms").to_dict(), "name": "mine"}, Task.shipped("two_arms").base_dir)
+    policy = train_latent_policy(arms_model, task, trials=1, episodes=3, overrides={"episode.max_steps": 20}, test_episodes=1)
+    assert policy.task.name == "mine" and policy.returns.shape == (1, 3) and policy.test_returns.shape == (1, 1)
 
 
 @pytest.mark.parametrize(
     ("kwargs", "error", "message"),
     [
-        ({"task": "walk"}, ValueError, "task must be one of"),
+        ({"task": "walk"}, ValueError, "task must be a Task or one of"),
+        ({"task": 3}, TypeError, "task must be a latentrl.Task"),
         ({"preset": "huge"}, ValueError, "preset must be 'quick' or 'paper'"),
         ({"episodes_per_trial": 3}, ValueError, "unknown preset fields"),
         ({"episodes": 0}, ValueError, "episodes must be an int >= 1"),
-        ({"task": "humanoid_lift"}, ValueError, "humanoid_lift needs a GPLVM with n_components=2 fitted to postures of its 19"),
+        ({"task": "humanoid_lift"}, ValueError, "humanoid_lift needs a GPLVM fitted to postures of its 19 joints"),
+        ({"overrides": {"learner.alpha": 2.0}}, ValueError, r"learner.alpha must lie in \(0, 1\], got 2"),
     ],
 )
 def test_bad_arguments(arms_model: GPLVM, kwargs: dict[str, object], error: type, message: str) -> None:
@@ -100,5 +145,5 @@ def test_bad_models() -> None:
     with pytest.raises(TypeError, match="fitted latentrl.GPLVM"):
         train_latent_policy(GPLVM())
     three = GPLVM(n_components=3, max_iter=5).fit(X)
-    with pytest.raises(ValueError, match="n_components=3"):
-        train_latent_policy(three)
+    policy = train_latent_policy(three, trials=1, episodes=2, overrides={"episode.max_steps": 5}, test_episodes=0)
+    assert policy.weights.shape == (1, 20**3), "a 3-D latent space: a 20³ grid"

@@ -2,7 +2,7 @@
 //! shipped URDFs. The property: [`exercise`] never panics, aborts or hangs; an `Err` from
 //! parsing, building or resetting is fine, a non-finite posture after stepping is not.
 
-use sim::{PhysicsSim, RootMode, SimOptions, UrdfModel};
+use sim::{PhysicsConfig, RootMode, UrdfModel, World, WorldConfig};
 
 /// Physics steps run per built world (a few are enough to reach the solver and contacts).
 pub const STEPS: usize = 4;
@@ -18,25 +18,28 @@ pub const SEEDS: [&str; 2] = [
 /// steps [`STEPS`] times and checks that the posture, velocities and root pose are finite.
 ///
 /// Panics (the fuzzer's "crash") on a non-finite state or if resetting to the start
-/// posture that `PhysicsSim::new` accepted fails.
+/// posture that `World::new` accepted fails.
 pub fn exercise(xml: &str) {
     let Ok(model) = UrdfModel::parse(xml) else {
         return;
     };
-    for (root, ground) in [(RootMode::Fixed, None), (RootMode::Floating, Some(-1.0))] {
-        let options = SimOptions {
+    for (root, floor) in [(RootMode::Fixed, None), (RootMode::Floating, Some(-1.0))] {
+        let options = WorldConfig {
             root,
-            ground,
-            substeps: 2,
-            ..SimOptions::default()
+            floor,
+            physics: PhysicsConfig {
+                substeps: 2,
+                ..PhysicsConfig::default()
+            },
+            ..WorldConfig::default()
         };
-        let Ok(mut sim) = PhysicsSim::new(model.clone(), options) else {
+        let Ok(mut sim) = World::new(model.clone(), options) else {
             continue;
         };
         let joints = model.joints();
         let start: Vec<f64> = joints.iter().map(|j| 0.0_f64.clamp(j.lower, j.upper)).collect();
         sim.reset(&start)
-            .expect("the start posture accepted by PhysicsSim::new resets");
+            .expect("the start posture accepted by World::new resets");
         let zeros = vec![0.0; joints.len()];
         let _ = sim.reset(&zeros);
         let middle: Vec<f64> = joints

@@ -308,6 +308,11 @@ class Estimator:
 
     def save(self, path: PathLike) -> None:
         """Writes the parameters and fitted state to an NPZ file at `path` (atomically)."""
+        arrays = self._arrays()
+        atomic_write(path, lambda fh: np.savez(fh, **arrays))
+
+    def _arrays(self) -> dict[str, Any]:
+        """The arrays `save` writes: format, version, parameters (JSON), fitted state."""
         self._check_fitted()
         try:
             params = json.dumps(self.get_params())
@@ -323,7 +328,7 @@ class Estimator:
         }
         if "feature_names_in_" in arrays:  # strings, not objects: `load` reads no pickles
             arrays["feature_names_in_"] = arrays["feature_names_in_"].astype(str)
-        atomic_write(path, lambda fh: np.savez(fh, **arrays))
+        return arrays
 
     @classmethod
     def load(cls, path: PathLike) -> Self:
@@ -333,6 +338,11 @@ class Estimator:
             arrays = read_npz(path)
         except ValueError as err:
             raise ValueError(f"{path}: {err}") from err
+        return cls._from_arrays(arrays, str(path))
+
+    @classmethod
+    def _from_arrays(cls, arrays: dict[str, Any], path: str) -> Self:
+        """The estimator of `_arrays`' output; `path` names it in errors."""
         expected = f"latentrl.{cls.__name__}"
         found = str(arrays["format"]) if "format" in arrays else None
         if found != expected:

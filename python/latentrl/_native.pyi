@@ -8,21 +8,30 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "BimanualPlant",
     "GpMap",
     "InternalError",
     "InvalidInputError",
+    "LatentPolicy",
     "LatentrlError",
     "NumericalError",
     "Sim",
+    "Task",
+    "TaskPlant",
     "__version__",
     "arms_elbows",
     "arms_fk",
     "arms_ik",
+    "bimanual_config",
+    "bimanual_schema",
+    "end_reasons",
+    "fall_check",
     "gplvm_nll_grad",
-    "humanoid_fall_check",
-    "run_arms_trials",
+    "latent_refusal",
+    "learner_values",
     "run_bimanual_trials",
-    "run_lift_trials",
+    "run_task_trials",
+    "task_schema",
 ]
 
 __version__: str
@@ -78,19 +87,13 @@ class Sim:
         urdf: str | PathLike[str],
         *,
         root: Literal["fixed", "floating"] = "fixed",
-        dt: float = ...,
-        substeps: int = 12,
-        solver_iterations: int = 4,
-        pgs_iterations: int = 1,
-        kp: float = 5000.0,
-        kd: float = 50.0,
-        max_force: float = ...,
-        gravity: NDArray[np.float64] | None = None,
-        ground: float | None = None,
+        floor: float | None = None,
+        physics: Mapping[str, object] | None = None,
+        servo: Mapping[str, object] | None = None,
     ) -> Sim:
-        """Builds the world from `urdf`: a path, or the URDF XML itself (a str starting
-        with `<`). `ground` is the height of a floor half-space (normal +z), or None for no
-        floor."""
+        """Builds the world from `urdf`: a path, or the URDF XML itself (a str starting with `<`).
+        `root` "fixed" or "floating"; `floor` the height of a floor half-space (normal +z) or
+        None; `physics` and `servo` dicts of the task file's `[physics]` and `[servo]` keys."""
     @property
     def joint_names(self) -> list[str]:
         """Names of the actuated joints, in the order of postures and targets."""
@@ -105,7 +108,7 @@ class Sim:
     def reset_on_ground(self, posture: NDArray[np.float64], sole: str, clearance: float = 5e-4) -> None:
         """Teleports a floating robot to `posture` at rest standing on the floor: the base is
         placed so that link `sole` lies flat, its lowest corner `clearance` m above the ground
-        (needs `ground`)."""
+        (needs a `floor`)."""
     def base_position(self) -> NDArray[np.float64]:
         """World position (3,) of the root link's origin (the floating base)."""
     def fall_status(
@@ -156,34 +159,26 @@ def arms_ik(hands: NDArray[np.float64]) -> NDArray[np.float64]:
     """Postures `(N, 4)` (elbows outward, shoulder angles continuous in front of the body) that
     put the hands at `hands` `(N, 4)`; an unreachable row raises InvalidInputError."""
 
-def humanoid_fall_check(
-    urdf_path: str,
+def fall_check(
+    task: Task,
     start: NDArray[np.float64],
     targets: NDArray[np.float64],
     *,
     hold: float,
-    kp: float,
-    kd: float,
-    max_force: float,
-    dt: float,
-    solver_iterations: int,
-    pgs_iterations: int,
-    grip_width: float,
     record_times: Sequence[float] = ...,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Fall check of the floating humanoid (SPEC §4.3): stand at `start` (D,), hold each row
-    of `targets` (M, D) for `hold` s. Returns (table (M, 7): fell, min margin, final margin,
-    grip error, max |grip error|, base height, fall time or NaN; frames (K, 9 + D) at the
-    reached `record_times`: time, fell, base position, base quaternion (x, y, z, w), joints)."""
+    """Runs the fall check (`sim::fallcheck::run_fall_check`) of `task` (a floating robot with a
+    `[fall]` rule and a distance constraint, the grip): in the task's world, stand at `start`
+    `(D,)`, hold each row of `targets` `(M, D)` for `hold` s."""
 
 def run_bimanual_trials(
-    learner: Literal["full", "latent"],
     *,
     n_trials: int,
     episodes: int,
     base_seed: int,
     first_trial: int | None = None,
-    config: Mapping[str, object] | None = None,
+    plant: Mapping[str, object] | None = None,
+    learner: Mapping[str, object] | None = None,
     decoder: GpMap | None = None,
     encoder: GpMap | None = None,
     latent_low: ArrayLike | None = None,
@@ -194,11 +189,156 @@ def run_bimanual_trials(
     return_weights: bool = False,
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
-    """Runs Experiment 1 (SPEC §4.1) trials in parallel in Rust; see
-    `run_bimanual_trials.__doc__` for every argument and the returned arrays."""
+    """Runs Experiment 1 (SPEC §4.1) trials in parallel in Rust and returns their records."""
 
-def run_arms_trials(
-    urdf: str | PathLike[str],
+def bimanual_config(
+    plant: Mapping[str, object] | None = None, learner: Mapping[str, object] | None = None
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Experiment 1's configuration checked: `(plant, learner)` dicts with every key's effective
+    value, or InvalidInputError naming the key and its rule."""
+
+def latent_refusal(
+    z: Sequence[float],
+    low: Sequence[float],
+    high: Sequence[float],
+    variance: float | None = None,
+    threshold: float | None = None,
+) -> int | None:
+    """Whether a latent target `z` (d,) is refused (`latent_core::refused`): the code of the box
+    exit (2) or the variance gate (5; `variance` and `threshold` given), or None."""
+
+@final
+class BimanualPlant:
+    """Experiment 1's kinematic two-hand toy as a plant (`sim::bimanual::BimanualPlant`): the
+    Gymnasium environment's state and rules."""
+
+    def __new__(cls, plant: Mapping[str, object] | None = None) -> BimanualPlant:
+        """The toy with `plant` (a dict of BimanualConfig keys; defaults for the rest)."""
+    def reset(self, posture: NDArray[np.float64]) -> int | None:
+        """Puts the hands at `posture` (4,): None, or the code of the rule it breaks."""
+    def step(self, target: NDArray[np.float64]) -> tuple[float, int | None]:
+        """Moves the hands to `target` (4,): `(reward, end code or None)`."""
+    def sample_start(self, seed: int) -> NDArray[np.float64]:
+        """A start (4,) by the toy's rule (left hand Gaussian around `start_mean`, right = left +
+        grip) from ChaCha8 seeded with `seed`."""
+    def state(self) -> NDArray[np.float64]:
+        """The hands (4,): x_L, y_L, x_R, y_R."""
+    def reached(self) -> bool:
+        """Whether the hands are within the reach radius of the target."""
+    def config(self) -> dict[str, Any]:
+        """The effective configuration."""
+
+@final
+class Task:
+    """A checked task: its configuration and its robot (docs/tasks.md)."""
+
+    @staticmethod
+    def load(path: str | PathLike[str]) -> Task:
+        """Reads a TOML task file (the URDF path relative to its folder)."""
+    @staticmethod
+    def from_dict(config: Mapping[str, object], base_dir: str | PathLike[str] = ..., origin: str = "<dict>") -> Task:
+        """A task from a dict of task-file keys; the URDF path is relative to `base_dir`, `origin`
+        names the task in errors."""
+    def to_dict(self) -> dict[str, Any]:
+        """Every key with its effective value, as a dict of task-file keys."""
+    @property
+    def name(self) -> str:
+        """The task's name."""
+    @property
+    def origin(self) -> str:
+        """Where the task came from (its file, or the name given)."""
+    @property
+    def joint_names(self) -> list[str]:
+        """Names of the robot's actuated joints, the columns of its postures."""
+    @property
+    def link_names(self) -> list[str]:
+        """Names of every URDF link, in URDF order."""
+    def collision_shapes(self) -> list[dict[str, Any]]:
+        """Every collision shape: dicts `{link, kind, size, origin}` (origin: the pose in the link's
+        frame, position and quaternion x, y, z, w), to draw the robot."""
+    @property
+    def effectors(self) -> list[str]:
+        """The names of the task's effectors."""
+    @property
+    def edges(self) -> list[tuple[str, str]]:
+        """`(parent link, child link)` of every URDF joint: the kinematic tree."""
+    @property
+    def lower(self) -> NDArray[np.float64]:
+        """Lower joint limits (rad or m; -inf for continuous joints)."""
+    @property
+    def upper(self) -> NDArray[np.float64]:
+        """Upper joint limits."""
+    @property
+    def row_len(self) -> int:
+        """Columns of a recorded path row: 3 per effector, base pose (7), joints."""
+    @property
+    def rl_dt(self) -> float:
+        """Duration of one RL step (s)."""
+
+@final
+class TaskPlant:
+    """The robot of a task in its world: the one plant of the learner, the environments and the
+    figures (docs/tasks.md has the rules it applies)."""
+
+    def __new__(cls, task: Task, demos: NDArray[np.float64] | None = None) -> TaskPlant:
+        """The task's robot standing at its home posture."""
+    def reset(self, posture: NDArray[np.float64]) -> int | None:
+        """Puts the robot at `posture` (D,); None if it may start an episode, else the code of
+        the rule it breaks."""
+    def step(self, target: NDArray[np.float64]) -> tuple[float, int | None, NDArray[np.float64]]:
+        """Tracks `target` (D,) for one RL step: `(reward, end code or None, reached posture (D,))`."""
+    def classify(self, postures: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """For each posture (M, D) at rest: the code of the rule it breaks (0: none) and the
+        effector positions (M, 3E)."""
+    def sample_start(self, seed: int) -> NDArray[np.float64]:
+        """A start posture drawn by the task's start rule from ChaCha8 seeded with `seed`."""
+    def effectors(self) -> NDArray[np.float64]:
+        """The effector positions (3E,): x, y, z per effector."""
+    def joint_positions(self) -> NDArray[np.float64]:
+        """The reached joint positions (D,)."""
+    def targets(self) -> NDArray[np.float64]:
+        """The servo targets after clamping (D,)."""
+    def row(self) -> NDArray[np.float64]:
+        """The task-space row recorded in paths: effectors, base position and quaternion, joints."""
+    def link_poses(self) -> NDArray[np.float64]:
+        """World poses (L, 7) of every URDF link (position, quaternion x, y, z, w)."""
+    def constraint_errors(self) -> NDArray[np.float64]:
+        """Each constraint's error now, in task-file order."""
+    def support_margin(self) -> float:
+        """The static support margin now (m; needs a fall rule)."""
+    def pose_links(self, base: NDArray[np.float64], joints: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Link poses (L, 7) of the robot at `joints` with its base at `base` (7,)."""
+    def center_of_mass(self) -> NDArray[np.float64]:
+        """The robot's centre of mass now (3,), from the URDF inertials."""
+    def reward(self) -> float:
+        """The reward now."""
+    def reached(self) -> bool:
+        """Whether the effectors are within the task's reach radius of the target."""
+
+@final
+class LatentPolicy:
+    """A trained latent policy: the learner's grid and weights over the latent box with the GPLVM's
+    maps; it acts greedily (the action of the largest look-ahead value)."""
+
+    def __new__(
+        cls,
+        learner: Mapping[str, object],
+        low: Sequence[float],
+        high: Sequence[float],
+        weights: NDArray[np.float64],
+        decoder: GpMap,
+        encoder: GpMap,
+    ) -> LatentPolicy:
+        """The policy of `learner` over [low, high] with `weights`."""
+    def act(
+        self, posture: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+        """The next servo target for the reached `posture`: `(target, z, next z)`."""
+    def values(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
+        """V(z) at `points` (M, d): the learner's own values."""
+
+def run_task_trials(
+    task: Task,
     *,
     decoder: GpMap,
     encoder: GpMap,
@@ -207,35 +347,32 @@ def run_arms_trials(
     n_trials: int,
     episodes: int,
     base_seed: int,
+    demos: NDArray[np.float64] | None = None,
+    weights: NDArray[np.float64] | None = None,
+    rollout: bool = False,
     first_trial: int | None = None,
-    config: Mapping[str, object] | None = None,
     record_episodes: Sequence[int] | None = None,
     test_episodes: int | None = None,
     record_test_episodes: Sequence[int] | None = None,
     return_weights: bool = False,
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
-    """Runs Experiment 2 (SPEC §4.2) trials in parallel in Rust on two simulated arms (rapier3d,
-    PD servos) learning in a 2-D latent space; see `run_arms_trials.__doc__`."""
+    """One trial runner for every task: trials of the task's latent learner in parallel in Rust."""
 
-def run_lift_trials(
-    urdf: str | PathLike[str],
-    *,
-    decoder: GpMap,
-    encoder: GpMap,
-    latent_low: ArrayLike,
-    latent_high: ArrayLike,
-    n_trials: int,
-    episodes: int,
-    base_seed: int,
-    first_trial: int | None = None,
-    config: Mapping[str, object] | None = None,
-    record_episodes: Sequence[int] | None = None,
-    test_episodes: int | None = None,
-    record_test_episodes: Sequence[int] | None = None,
-    return_weights: bool = False,
-    progress: Callable[[int, int], object] | None = None,
-) -> dict[str, Any]:
-    """Runs Experiment 3 (SPEC §4.3) trials in parallel in Rust on the simulated humanoid
-    (rapier3d, servo PD, floor) lifting an object from a 2-D latent space; see
-    `run_lift_trials.__doc__`."""
+def learner_values(
+    learner: Mapping[str, object],
+    low: Sequence[float],
+    high: Sequence[float],
+    weights: NDArray[np.float64],
+    points: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """V(z) = wᵀ b(z) (Eq. 7) at `points` (M, d): the learner's own sparse features."""
+
+def task_schema() -> list[dict[str, Any]]:
+    """Every key of a task file as dicts `{key, doc, rule, kind, default}`."""
+
+def bimanual_schema() -> list[dict[str, Any]]:
+    """The keys of Experiment 1's configuration (`plant.*`, `learner.*`), as `task_schema`."""
+
+def end_reasons() -> list[str]:
+    """The end reasons by code: their names in results files (0 timeout … 5 variance_gate)."""

@@ -83,16 +83,24 @@ def value_function(
     low: NDArray[np.float64],
     high: NDArray[np.float64],
     points: NDArray[np.float64],
+    *,
+    width: float = 1.0,
+    cutoff: float | None = 3.0,
 ) -> NDArray[np.float64]:
-    """V(z) = Σ w_i b_i(z) at `points` (M, 2) with dense normalised RBFs (σ = spacing) on the
-    learner's grid, flat index with dimension 0 fastest (as the Rust grid). The learner's
-    3σ cut-off changes V by less than the Rust tests' stated tolerance."""
-    n = int(round(np.sqrt(weights.size)))
+    """V(z) = Σ w_i b_i(z) at `points` (M, d) with normalised RBFs on the learner's grid of
+    `weights.size ** (1/d)` centres per dimension, flat index with dimension 0 fastest (as the
+    Rust grid), σ_k = `width` × spacing_k; with `cutoff` (in σ) only centres within it count, as
+    the learner's sparse features (None: dense). Points more than `cutoff` σ from every centre are
+    not handled (the learner falls back to the nearest centre)."""
+    d = points.shape[1]
+    n = int(round(weights.size ** (1.0 / d)))
     axes = [np.linspace(lo, hi, n) for lo, hi in zip(low, high)]
-    c0, c1 = np.meshgrid(axes[0], axes[1], indexing="xy")
-    centres = np.column_stack([c0.ravel(), c1.ravel()])
-    sigma = (high - low) / (n - 1)
+    mesh = np.meshgrid(*axes[::-1], indexing="ij")  # last axis slowest → dimension 0 fastest
+    centres = np.stack(mesh[::-1], axis=-1).reshape(-1, d)
+    sigma = width * (np.asarray(high) - np.asarray(low)) / (n - 1)
     d2 = (((points[:, None, :] - centres[None, :, :]) / sigma) ** 2).sum(axis=-1)
-    phi = np.exp(-0.5 * (d2 - d2.min(axis=1, keepdims=True)))
+    phi = np.exp(-0.5 * d2)
+    if cutoff is not None:
+        phi = np.where(d2 <= cutoff**2, phi, 0.0)
     values: NDArray[np.float64] = (phi @ weights) / phi.sum(axis=1)
     return values

@@ -1,9 +1,9 @@
-"""The `latentrl` command: run an experiment or a sweep of it (locally or on a Ray cluster), fit
-a model to demonstrations, redraw the figures of a results directory, show versions.
+"""The `latentrl` command: run an experiment or a sweep of it (locally or on a Ray cluster), train
+a latent policy on a task of your own and roll it out, fit a model to demonstrations, redraw
+the figures of a results directory, show versions.
 
-Exit codes: 0 done, 1 bad values or a failed run (the message says what), 2 bad arguments
-(argparse), 130 interrupted (finished trials are kept; `latentrl run EXP --resume DIR`
-continues).
+Exit codes: 0 done, 1 bad values, a bad file or a failed run (the message says what), 2 bad
+arguments (argparse), 130 interrupted (finished trials are kept; `--resume` continues).
 """
 
 from __future__ import annotations
@@ -12,13 +12,17 @@ import argparse
 import dataclasses
 import json
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from latentrl.experiments.presets import field_docs
-from latentrl.experiments.registry import experiments
-from latentrl.experiments.results import environment, read_json
+from latentrl import _native
+from latentrl.experiments.presets import field_docs, with_overrides
+from latentrl.experiments.registry import experiments, task_schema
+from latentrl.experiments.results import environment, read_json, write_json
+
+TASK_PREFIX = "task:"
+"""Prefix of the argparse destinations of task keys (`task:learner.alpha`)."""
 
 
 def saved_run(out_dir: Path) -> tuple[str, Any]:
@@ -41,20 +45,75 @@ def saved_run(out_dir: Path) -> tuple[str, Any]:
     return name, preset_cls(**fields)
 
 
-def _add_preset_flags(parser: argparse.ArgumentParser, preset_cls: type) -> None:
-    """One `--field-name` flag per scalar preset field, its help the field's docstring."""
+def _add_preset_flags(parser: argparse.ArgumentParser, preset_cls: type, exclude: tuple[str, ...] = ()) -> None:
+    """One `--field-name` flag per scalar preset field but `exclude`, its help the field's docstring."""
     docs = field_docs(preset_cls)
+    group = parser.add_argument_group("run options")
     for field in dataclasses.fields(preset_cls):
         kind = type(field.default) if field.default is not dataclasses.MISSING else None
-        if kind not in (int, float, str, bool):
+        if kind not in (int, float, str, bool) or field.name in exclude:
             continue
         flag = "--" + field.name.replace("_", "-")
         # argparse %-formats help strings: a literal "%" in a docstring must be doubled.
         help_text = f"{docs.get(field.name, '')} (default: {field.default})".replace("%", "%%")
         if kind is bool:
-            parser.add_argument(flag, dest=field.name, action=argparse.BooleanOptionalAction, default=None, help=help_text)
+            group.add_argument(flag, dest=field.name, action=argparse.BooleanOptionalAction, default=None, help=help_text)
         else:
-            parser.add_argument(flag, dest=field.name, type=kind, default=None, help=help_text)
+            group.add_argument(flag, dest=field.name, type=kind, default=None, help=help_text)
+
+
+def _value_parser(kind: str) -> tuple[Callable[[str], Any], list[str] | None]:
+    """How a task key's flag reads its value: by the native kind (float, int, str, bool, a
+    choice "a | b", "… or none", lists and tables as JSON)."""
+    optional = kind.endswith(" or none")
+    base = kind.removesuffix(" or none")
+    scalar: dict[str, Callable[[str], Any]] = {"float": float, "int": int, "str": str}
+
+    def parse(text: str) -> Any:
+        if optional and text.lower() in ("none", "null"):
+            return None
+        if base in scalar:
+            return scalar[base](text)
+        if base == "bool":
+            if text.lower() not in ("true", "false"):
+                raise argparse.ArgumentTypeError(f"expected true or false, got {text!r}")
+            return text.lower() == "true"
+        if "|" in base:
+            return text
+        try:
+            return json.loads(text)
+        except json.JSONDecodeError as err:
+            raise argparse.ArgumentTypeError(f"expected {kind} as JSON, e.g. [0.1, 0.0, 0.0]: {err}") from err
+
+    parse.__name__ = kind  # argparse names the type in its errors
+    choices = [c.strip() for c in base.split("|")] if "|" in base else None
+    return parse, choices
+
+
+def _add_task_flags(
+    parser: argparse.ArgumentParser, schema: Sequence[dict[str, Any]], task: dict[str, Any] | None = None
+) -> None:
+    """One `--table.key` flag per key of a task table (the native schema: one name, doc, rule and
+    default per parameter), grouped by table; the default shown is `task`'s value where given (an
+    experiment's task file), else the schema's."""
+    groups: dict[str, Any] = {}
+    for entry in schema:
+        key = entry["key"]
+        if "." not in key or "[]" in key or "NAME" in key or entry["kind"].startswith("table"):
+            continue
+        table, _, name = key.rpartition(".")
+        group = groups.setdefault(table, parser.add_argument_group(f"[{table}] (task keys)"))
+        parse, choices = _value_parser(entry["kind"])
+        rule = "" if entry["rule"] == "any value" else f"; {entry['rule']}"
+        default = entry["default"]
+        if task is not None:
+            node: Any = task
+            for part in key.split("."):
+                node = node.get(part) if isinstance(node, dict) else None
+            default = node if node is not None or table not in task else default
+        help_text = f"{entry['doc']} ({entry['kind']}{rule}; default: {default})".replace("%", "%%")
+        group.add_argument(f"--{table}.{name.replace('_', '-')}", dest=TASK_PREFIX + key, type=parse,
+                           choices=choices, default=None, metavar=entry["kind"].upper().split()[0], help=help_text)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -74,6 +133,27 @@ def build_parser() -> argparse.ArgumentParser:
             )
         cmd.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
         _add_preset_flags(cmd, exp.preset)
+        if exp.rl:
+            _add_task_flags(cmd, task_schema(name), exp.rl.task(exp.preset()))
+    train = sub.add_parser("train", help="train a latent policy on a task file from demonstrations; writes DIR/policy.npz")
+    train.add_argument("task", type=Path, help="the task file (TOML; docs/tasks.md)")
+    train.add_argument("--demos", type=Path, required=True, help="demonstrated postures: .csv (header of joint names), .npz or .json")
+    train.add_argument("--out", type=Path, required=True, help="results directory (results.json, returns.npz, policy.npz)")
+    train.add_argument("--model", type=Path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2)")
+    train.add_argument("--quick", action="store_true", help="a short run (TrainPreset.quick)")
+    train.add_argument("--resume", action="store_true", help="continue the interrupted run in --out (same arguments)")
+    train.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
+    from latentrl.experiments.training import TrainRun
+
+    _add_preset_flags(train, TrainRun, exclude=("task_file", "demos", "model"))
+    _add_task_flags(train, _native.task_schema())  # defaults: the task file's, else these
+    rollout = sub.add_parser("rollout", help="run a trained policy (greedy, no learning) and write OUT/rollout.json")
+    rollout.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz), or a policy.npz")
+    rollout.add_argument("--out", type=Path, required=True, help="where to write rollout.json and rollout.npz")
+    rollout.add_argument("--episodes", type=int, default=20, help="episodes per trial (default: 20)")
+    rollout.add_argument("--trial", type=int, help="only this trial's policy (default: every trial)")
+    rollout.add_argument("--seed", type=int, default=0, help="base seed of the starts (default: 0)")
+    rollout.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     fit = sub.add_parser("fit", help="fit a PCA or GPLVM to a demonstration file and save it (NPZ)")
     fit.add_argument("demos", type=Path, help="demonstrated postures: .csv (header of joint names), .npz or .json")
     fit.add_argument("--model", choices=("gplvm", "pca"), default="gplvm", help="the model (default: gplvm)")
@@ -99,15 +179,25 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _overrides(args: argparse.Namespace, preset_cls: type) -> dict[str, Any]:
+    """The preset fields and task keys the command line sets."""
+    names = {f.name for f in dataclasses.fields(preset_cls)} - {"task", "task_file", "demos", "model"}
+    out = {name: getattr(args, name) for name in names if getattr(args, name, None) is not None}
+    out.update({dest[len(TASK_PREFIX):]: v for dest, v in vars(args).items() if dest.startswith(TASK_PREFIX) and v is not None})
+    return out
+
+
+def _flag(key: str) -> str:
+    table, _, name = key.rpartition(".")
+    return f"--{table + '.' if table else ''}{name.replace('_', '-')}"
+
+
 def _run(args: argparse.Namespace) -> int:
     exp = experiments()[args.experiment]
-    overrides = {
-        f.name: getattr(args, f.name) for f in dataclasses.fields(exp.preset) if getattr(args, f.name, None) is not None
-    }
+    overrides = _overrides(args, exp.preset)
     resume = getattr(args, "resume", None)
     if resume is not None and (overrides or args.quick or args.out):
-        flags = ["--quick"] * args.quick + ["--out"] * bool(args.out)
-        flags += ["--" + name.replace("_", "-") for name in overrides]
+        flags = ["--quick"] * args.quick + ["--out"] * bool(args.out) + [_flag(k) for k in overrides]
         print(f"latentrl: error: --resume takes the saved run's preset and directory; drop {' '.join(flags)}",
               file=sys.stderr)
         return 2
@@ -118,15 +208,68 @@ def _run(args: argparse.Namespace) -> int:
             raise ValueError(f"{resume} holds a run of {name}, not of {args.experiment}")
     else:
         base = exp.preset.quick() if args.quick else exp.preset()  # type: ignore[attr-defined]
-        preset = dataclasses.replace(base, **overrides)
+        preset = with_overrides(base, overrides)
+    preset.validate()
+    return _interruptible(lambda: exp.run(preset, out, progress=args.progress), out,
+                          f"latentrl run {args.experiment} --resume {out}")
+
+
+def _interruptible(work: Callable[[], object], out: Path, resume_command: str) -> int:
+    """Runs `work`; Ctrl-C gives exit 130 and, if `out` holds finished trials, how to continue."""
     try:
-        exp.run(preset, out, progress=args.progress)
+        work()
     except KeyboardInterrupt:
-        print(
-            f"interrupted; finished trials are in {out}; continue with: latentrl run {args.experiment} --resume {out}",
-            file=sys.stderr,
-        )
+        if (out / "results.json").is_file():
+            print(f"interrupted; finished trials are in {out}; continue with: {resume_command}", file=sys.stderr)
+        else:
+            print("interrupted before any trial finished; nothing was written", file=sys.stderr)
         return 130
+    return 0
+
+
+def _train(args: argparse.Namespace) -> int:
+    from latentrl.experiments.training import TrainRun
+    from latentrl.experiments.training_run import run_training  # matplotlib: the [plot] extra
+
+    base = TrainRun.quick() if args.quick else TrainRun()
+    overrides = _overrides(args, TrainRun)
+    files = {"task_file": str(args.task), "demos": str(args.demos), "model": str(args.model or "")}
+    run = dataclasses.replace(with_overrides(base, overrides), **files)
+    meta_path = args.out / "results.json"
+    if meta_path.is_file() and not args.resume:
+        raise ValueError(f"{args.out} holds a run already: add --resume to continue it, or choose another --out")
+    run.validate()  # every file, key and column checked before anything is written
+    command = "the same latentrl train command with --resume"
+    code = _interruptible(lambda: run_training(run, args.out, progress=args.progress), args.out, command)
+    if code == 0:
+        print(f"trained {run.trials} trial(s) of {run.episodes} episodes; policy in {args.out / 'policy.npz'}")
+    return code
+
+
+def _rollout(args: argparse.Namespace) -> int:
+    from latentrl.train import LatentPolicy
+
+    path = args.results / "policy.npz" if args.results.is_dir() else args.results
+    policy = LatentPolicy.load(path)
+    if args.episodes < 1:
+        raise ValueError(f"--episodes must be at least 1, got {args.episodes}")
+    from tqdm import tqdm
+
+    with tqdm(unit="ep", desc="rollout", disable=not args.progress) as bar:
+        def report(done: int, total: int) -> None:
+            bar.total = total
+            bar.n = done
+            bar.refresh()
+
+        result = policy.rollout(args.episodes, trial=args.trial, seed=args.seed, progress=report)
+    args.out.mkdir(parents=True, exist_ok=True)
+    from latentrl.experiments.results import write_npz
+
+    write_npz(args.out / "rollout.npz", {k: result[k] for k in ("returns", "ends", "reached", "paths")})
+    summary = {"policy": str(path), "task": policy.task.name, "trials": result["trials"], "episodes": args.episodes,
+               "seed": args.seed, **result["summary"], "environment": environment()}
+    write_json(args.out / "rollout.json", summary)
+    print(json.dumps({k: summary[k] for k in ("reached", "ends", "mean_return")}))
     return 0
 
 
@@ -193,9 +336,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "info":
         print(json.dumps(environment(), indent=2))
         return 0
-    command = {"run": _run, "fit": _fit, "plot": _plot, "sweep": _sweep}[args.command]
+    command = {"run": _run, "train": _train, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep}
     try:
-        return command(args)
+        return command[args.command](args)
     except (ValueError, OSError) as err:
         print(f"latentrl: error: {err}", file=sys.stderr)
         return 1

@@ -18,8 +18,8 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
+from latentrl import _native  # noqa: E402
 from latentrl._base import atomic_write  # noqa: E402
-from latentrl._reference import value_function  # noqa: E402
 
 
 def running_mean(values: NDArray[np.float64], window: int) -> NDArray[np.float64]:
@@ -86,17 +86,19 @@ def latent_value_panel(
     high: NDArray[np.float64],
     model: Any,
     *,
+    learner: Mapping[str, Any],
     regions: Regions | None = None,
     grid: int = 120,
 ) -> None:
-    """V over the 2-D latent box [low, high] (`value_function` of `weights`), the GPLVM variance
-    of `model.decoder_` shaded (darker = higher, log scale), the experiment's `regions` and
-    the demonstrations' latent points `model.Z_` (white dots) (paper Fig. 6b/d, 7b/c)."""
+    """V over the 2-D latent box [low, high] (the learner's own V of `weights`, native), the GPLVM
+    variance of `model.decoder_` shaded (darker = higher, log scale), the experiment's `regions`
+    and the demonstrations' latent points `model.Z_` (white dots) (paper Fig. 6b/d, 7b/c)."""
     g0, g1 = np.meshgrid(np.linspace(low[0], high[0], grid), np.linspace(low[1], high[1], grid))
     points = np.column_stack([g0.ravel(), g1.ravel()])
     postures, variance = model.decoder_.predict(points)
     shape = g0.shape
-    value = value_function(weights, low, high, points).reshape(shape)
+    value = _native.learner_values(dict(learner), list(low), list(high), np.asarray(weights, dtype=np.float64), points)
+    value = value.reshape(shape)
     extent = (low[0], high[0], low[1], high[1])
     image = ax.imshow(value, origin="lower", extent=extent, aspect="auto", cmap="viridis")
     plt.colorbar(image, ax=ax, label="V")
@@ -120,19 +122,21 @@ def latent_run_figures(
     *,
     names: tuple[str, str, str],
     title: str,
+    learner: Mapping[str, Any],
     panel: Callable[[Axes, NDArray[np.float64]], None],
 ) -> None:
     """A latent learner's return curve (`names[0]`: mean ± s.d. over trials, running mean of
     min(`curve_window`, episodes // 5)) and its value function before (`names[1]`: the
     initial weight everywhere) and after learning (`names[2]`: trial 1), each drawn by
-    `panel(ax, weights)`; the latter only if the run kept its weights."""
+    `panel(ax, weights)`; the latter only if the run kept its weights. `learner`: the task's
+    learner configuration (its grid and w₀)."""
     fig, ax = plt.subplots(figsize=(6, 4))
     window = max(1, min(preset.curve_window, preset.episodes // 5))
     learning_curves(ax, {"latent": arrays["latent"]}, window=window)
     ax.set_title(title)
     save_figure(fig, out_dir, names[0])
     weights = arrays.get("latent_weights")
-    before = np.full(preset.rbf_per_dim**2, preset.initial_weight)
+    before = np.full(int(learner["rbf_per_dim"]) ** 2, float(learner["initial_weight"]))
     for name, w, when in ((names[1], before, "before learning"), (names[2], weights, "after learning (trial 1)")):
         if w is None:
             continue
@@ -154,15 +158,32 @@ def shown_paths(arrays: Mapping[str, np.ndarray]) -> tuple[np.ndarray | None, st
 def side_view_stick(
     ax: Axes,
     edges: Sequence[tuple[str, str]],
-    poses: Mapping[str, NDArray[np.float64]],
+    positions: Mapping[str, NDArray[np.float64]],
     colour: str,
     dx: float = 0.0,
 ) -> None:
     """A robot's kinematic tree as a stick figure in the x–z plane: one segment per (parent,
-    child) link of `edges` between the origins of their world `poses` (4×4), shifted by `dx`."""
+    child) link of `edges` between their world `positions` (x, y, z), shifted by `dx`."""
     for parent, child in edges:
-        a, b = poses[parent][:3, 3], poses[child][:3, 3]
+        a, b = positions[parent], positions[child]
         ax.plot([dx + a[0], dx + b[0]], [a[2], b[2]], "o-", color=colour, lw=2, ms=2)
+
+
+def box_corners(link_pose: NDArray[np.float64], shape: Mapping[str, Any]) -> NDArray[np.float64]:
+    """World corners (8, 3) of a box collision shape (`Task.collision_shapes` entry) of a link at
+    `link_pose` (7,: position, quaternion x, y, z, w); corner k has bit 1 / 2 / 4 set for +x / +y / +z."""
+    from scipy.spatial.transform import Rotation
+
+    signs = np.array([[(k >> b & 1) - 0.5 for b in range(3)] for k in range(8)])
+    local = signs * np.asarray(shape["size"])
+    origin = np.asarray(shape["origin"])
+    in_link = Rotation.from_quat(origin[3:]).apply(local) + origin[:3]
+    return Rotation.from_quat(link_pose[3:]).apply(in_link) + link_pose[:3]
+
+
+def link_positions(names: Sequence[str], poses: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+    """Link name → world position, from native link poses (L, 7) in `names` order."""
+    return {name: pose[:3] for name, pose in zip(names, poses)}
 
 
 def save_figure(fig: Figure, out_dir: Path, name: str) -> list[Path]:

@@ -1,147 +1,270 @@
-"""Train a latent-space TD(0) policy (SPEC §3.1) on a shipped simulated robot from your own
-fitted GPLVM: the learner of Experiments 2 and 3, without their demonstrations and figures.
+"""Train a latent-space TD(0) policy (SPEC §3.1) on any task from your own fitted GPLVM, save
+it, load it and run it.
 
-The task is the experiment's: ``"two_arms"`` (Exp. 2: both hands to the target through the
-corridor, `latentrl.experiments.exp2`) or ``"humanoid_lift"`` (Exp. 3: lift the object past
-the obstacle, `latentrl.experiments.exp3`). Every step runs in Rust: decode the latent target
-with the GPLVM's GP, track it with the simulated servos for one RL step, encode the reached
-posture, update V; trials run in parallel with the GIL released.
+    task = Task.load("my_robot.toml")
+    policy = train_latent_policy(model, task, demos=postures, trials=2, episodes=300)
+    policy.save("runs/my_robot/policy.npz")
+    target = LatentPolicy.load("runs/my_robot/policy.npz").act(posture)   # next servo target
+
+Every step runs in Rust: decode the latent target with the GPLVM's GP, track it with the
+simulated servos for one RL step, encode the reached posture, update V; trials run in parallel
+with the GIL released. The shipped tasks' names ("two_arms", "humanoid_lift") are shortcuts
+that use Experiment 2's and 3's presets.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+import json
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 from tqdm import tqdm
 
-from latentrl import humanoid
-from latentrl._reference import value_function
-from latentrl.experiments import exp2, exp3
-from latentrl.experiments.presets import latent_box
-from latentrl.experiments.runner import END_CODES, RunTrials, Setup, episodes_per_trial, run_in_process
+from latentrl import _native
+from latentrl._base import FORMAT_VERSION, PathLike, atomic_write, read_npz
+from latentrl.experiments.latent_runs import task_learner
+from latentrl.experiments.presets import LatentRun, latent_box, with_overrides
+from latentrl.experiments.runner import Setup, episodes_per_trial, run_in_process
 from latentrl.gplvm import GPLVM
+from latentrl.task import SHIPPED, Task, end_reasons
 
 
-class Task(NamedTuple):
-    """A task of `train_latent_policy`: its experiment's preset and learner, and the joints
-    (in column order) of the robot whose postures the GPLVM must be fitted to."""
+@dataclass(frozen=True)
+class TrainPreset(LatentRun):
+    """Training a latent policy on a task of your own (`latentrl train`)."""
 
-    preset: type
-    learner: Callable[[Any, GPLVM, NDArray[np.float64], NDArray[np.float64]], RunTrials]
-    joint_names: Callable[[], tuple[str, ...]]
+    trials: int = 4
+    """Independent RL trials; the policy keeps each trial's weights (ours: 4)."""
+    episodes: int = 2000
+    """Training episodes per trial (ours: 2000)."""
+    test_episodes: int = 20
+    """Frozen test episodes per trial after training (no TD updates, the task's test starts; ours: 20)."""
+
+    def validate(self) -> None:
+        """ValueError naming the first impossible field."""
+        self.check_run()
+
+    @classmethod
+    def quick(cls) -> TrainPreset:
+        """A short run to see that it learns: 2 trials × 300 episodes, 10 test episodes, w₀ = 1/(1 − γ)
+        (optimistic: much faster than 0) and half-spacing latent steps."""
+        return dataclasses.replace(
+            cls(), trials=2, episodes=300, test_episodes=10,
+            task={"learner.initial_weight": 100.0, "learner.step": 0.5},
+        )
 
 
-TASKS = {
-    "two_arms": Task(exp2.Exp2Preset, exp2.learner, lambda: exp2.JOINT_NAMES),
-    "humanoid_lift": Task(exp3.Exp3Preset, exp3.learner, lambda: tuple(humanoid.model().joint_names)),
-}
-"""The tasks by name: Experiment 2's two arms and Experiment 3's humanoid lift."""
+def _preset_for(task: Task | str, quick: bool, fields: Mapping[str, Any]) -> tuple[Task, Any]:
+    """The task and the preset of a training run: a shipped task's name takes its experiment's
+    preset (Exp. 2, 3), a Task the `TrainPreset`; `fields` override either."""
+    if isinstance(task, str):
+        if task not in SHIPPED:
+            raise ValueError(f"task must be a Task or one of {list(SHIPPED)}, got {task!r}")
+        from latentrl.experiments import exp2, exp3
 
-
-@dataclass(frozen=True, eq=False)
-class LatentPolicy:
-    """What `train_latent_policy` learnt: the value weights of each trial over the RBF grid of
-    the latent box, and the per-episode record of the training (each (trials, episodes))."""
-
-    task: str
-    preset: Any
-    """The experiment preset the trials ran with (`Exp2Preset` or `Exp3Preset`)."""
-    latent_low: NDArray[np.float64]
-    latent_high: NDArray[np.float64]
-    weights: NDArray[np.float64]
-    """(trials, rbf_per_dim²) final TD(0) weights."""
-    returns: NDArray[np.float64]
-    """Return of every training episode."""
-    ends: NDArray[np.int8]
-    """How every training episode ended, a code of `END_CODES`."""
-    reached: NDArray[np.bool_]
-    """Whether the hands came within `reach_radius` of the target in each episode."""
-    test_returns: NDArray[np.float64]
-    """Return of every frozen test episode after training (the learnt weights, no TD updates,
-    starts as the preset's `test_episodes` say), each (trials, test_episodes)."""
-    test_ends: NDArray[np.int8]
-    """How every frozen test episode ended, a code of `END_CODES`."""
-    test_reached: NDArray[np.bool_]
-    """Whether the hands came within `reach_radius` of the target in each test episode."""
-
-    def value(self, z: Any, trial: int = 0) -> NDArray[np.float64]:
-        """V(z) of trial `trial` at latent points `z` (M, 2)."""
-        points = np.asarray(z, dtype=np.float64)
-        if points.ndim != 2 or points.shape[1] != len(self.latent_low):
-            raise ValueError(f"z must have shape (M, {len(self.latent_low)}), got {points.shape}")
-        if not 0 <= trial < len(self.weights):
-            raise ValueError(f"trial must be in 0..{len(self.weights) - 1}, got {trial!r}")
-        return value_function(self.weights[trial], self.latent_low, self.latent_high, points)
-
-    def end_counts(self, last: int | None = None) -> dict[str, int]:
-        """How many of the (`last`) training episodes of all trials ended each way."""
-        ends = self.ends if last is None else self.ends[:, -last:]
-        return {END_CODES[int(c)]: int(n) for c, n in zip(*np.unique(ends, return_counts=True))}
-
-    def __repr__(self) -> str:
-        trials, episodes = self.returns.shape
-        return f"LatentPolicy({self.task!r}, {trials} trials × {episodes} episodes)"
+        cls: Any = {"two_arms": exp2.Exp2Preset, "humanoid_lift": exp3.Exp3Preset}[task]
+        task = Task.shipped(task)
+    elif isinstance(task, Task):
+        cls = TrainPreset
+    else:
+        raise TypeError(f"task must be a latentrl.Task or a shipped task's name, got {type(task).__name__}")
+    preset = with_overrides(cls.quick() if quick else cls(), fields)
+    preset.validate()
+    return task.replace(preset.task), preset
 
 
 def train_latent_policy(
     model: GPLVM,
-    task: str = "two_arms",
+    task: Task | str = "two_arms",
     *,
+    demos: Any = None,
     preset: str = "quick",
     progress: bool = False,
+    overrides: Mapping[str, Any] | None = None,
     **fields: Any,
 ) -> LatentPolicy:
     """Trains the latent TD(0) learner of `task` through the physics sim in the latent space of
-    `model`, a GPLVM fitted to postures of the task's robot (columns in its joint order:
-    `experiments.exp2.JOINT_NAMES`, `humanoid.model().joint_names`).
+    `model`, a GPLVM fitted to postures of the task's robot (columns in its joint order,
+    `task.joint_names`).
 
-    `preset` is ``"quick"`` (the experiment's smoke-test budget) or ``"paper"``; any `fields`
-    of the experiment's preset override it (``trials=4, episodes=500, seed=1, ...``, see
-    ``latentrl run exp2 --help``). The latent box is the bounding box of ``model.Z_`` widened
-    by ``latent_margin``. Ctrl-C stops the run with `KeyboardInterrupt`.
+    `preset` is ``"quick"`` (a short budget) or ``"paper"`` (the full one); `fields` override
+    its fields by name (``trials=4, episodes=500, seed=1``), `overrides` the task's keys by path
+    (``overrides={"learner.alpha": 0.5, "episode.max_steps": 200}``). `demos` (N, D): the postures a ``start = "demo"``
+    task starts from (default: the model's training postures). The latent box is the bounding
+    box of ``model.Z_`` widened by ``latent_margin``. Ctrl-C stops the run with
+    `KeyboardInterrupt`.
     """
-    if task not in TASKS:
-        raise ValueError(f"task must be one of {sorted(TASKS)}, got {task!r}")
     if preset not in ("quick", "paper"):
         raise ValueError(f"preset must be 'quick' or 'paper', got {preset!r}")
     if not isinstance(model, GPLVM) or not hasattr(model, "decoder_"):
         raise TypeError(f"model must be a fitted latentrl.GPLVM, got {model!r}")
-    chosen_task = TASKS[task]
-    cls = chosen_task.preset
-    known = {f.name for f in dataclasses.fields(cls)}
-    unknown = sorted(set(fields) - known)
-    if unknown:
-        raise ValueError(f"unknown preset fields {unknown}; {cls.__name__} has {sorted(known)}")
-    chosen = dataclasses.replace(cls.quick() if preset == "quick" else cls(), **fields)  # type: ignore[attr-defined]
-    chosen.validate()
-    joints = chosen_task.joint_names()
-    if model.n_features_in_ != len(joints) or model.n_components != 2:
+    task, chosen = _preset_for(task, preset == "quick", {**fields, **(overrides or {})})
+    if model.n_features_in_ != len(task.joint_names):
         raise ValueError(
-            f"{task} needs a GPLVM with n_components=2 fitted to postures of its {len(joints)} "
-            f"joints {list(joints)}; got n_components={model.n_components}, "
-            f"n_features_in_={model.n_features_in_}"
+            f"{task.name} needs a GPLVM fitted to postures of its {len(task.joint_names)} joints "
+            f"{list(task.joint_names)}; got n_features_in_={model.n_features_in_}"
         )
-    if getattr(chosen, "start_demo", 0) >= len(model.X_train_):
-        raise ValueError(f"start_demo={chosen.start_demo} is not a row of the model's {len(model.X_train_)} postures")
+    starts = np.asarray(model.X_train_ if demos is None else demos, dtype=np.float64)
     low, high = latent_box(model.Z_, chosen.latent_margin)
-    built = Setup(learners={"latent": chosen_task.learner(chosen, model, low, high)})
+    learner = task_learner(
+        task, model, (low, high), starts, episodes=chosen.episodes, seed=chosen.seed, test_episodes=chosen.test_episodes
+    )
+    built = Setup(learners={"latent": learner})
     with tqdm(total=chosen.trials * episodes_per_trial(chosen), unit="ep", desc="episodes", disable=not progress) as bar:
         *_, result = next(iter(run_in_process(built, [("latent", 0, chosen.trials)], bar.update)))
     return LatentPolicy(
-        task=task,
-        preset=chosen,
-        latent_low=low,
-        latent_high=high,
-        weights=np.asarray(result["weights"]),
-        returns=np.asarray(result["returns"]),
-        ends=np.asarray(result["ends"]),
-        reached=np.asarray(result["reached"]),
-        test_returns=np.asarray(result["test_returns"]),
-        test_ends=np.asarray(result["test_ends"]),
-        test_reached=np.asarray(result["test_reached"]),
+        task=task, model=model, demos=starts, latent_low=low, latent_high=high, weights=np.asarray(result["weights"]),
+        preset=chosen, record={k: np.asarray(result[k]) for k in RECORD},
     )
+
+
+RECORD = ("returns", "ends", "reached", "test_returns", "test_ends", "test_reached")
+"""What a policy keeps of its training: per episode and per frozen test episode, each (trials, episodes)."""
+
+
+class LatentPolicy:
+    """What `train_latent_policy` learnt: the value weights of each trial over the RBF grid of the
+    latent box, the GPLVM that maps it, the task, and the record of the training. It acts
+    greedily (`act`), runs (`rollout`), and saves to and loads from one NPZ file."""
+
+    def __init__(
+        self,
+        *,
+        task: Task,
+        model: GPLVM,
+        demos: NDArray[np.float64],
+        latent_low: NDArray[np.float64],
+        latent_high: NDArray[np.float64],
+        weights: NDArray[np.float64],
+        preset: Any = None,
+        record: Mapping[str, NDArray[Any]] | None = None,
+    ) -> None:
+        self.task, self.model, self.demos = task, model, demos
+        self.latent_low, self.latent_high = np.asarray(latent_low), np.asarray(latent_high)
+        self.weights = np.asarray(weights, dtype=np.float64)
+        """(trials, rbf_per_dim^d) final TD(0) weights."""
+        self.preset = preset
+        """The preset the trials ran with (None for a loaded policy)."""
+        self.record = dict(record or {})
+        """Per training episode: returns, ends (codes of `end_reasons()`), reached; the same for
+        the frozen test episodes (`test_*`); each (trials, episodes)."""
+        learner = task.to_dict()["learner"]
+        self._native = [
+            _native.LatentPolicy(learner, list(self.latent_low), list(self.latent_high), w, model.decoder_, model.encoder_)
+            for w in self.weights
+        ]
+
+    def __getattr__(self, name: str) -> Any:
+        record = self.__dict__.get("record", {})
+        if name in record:
+            return record[name]
+        raise AttributeError(name)
+
+    def act(self, posture: Any, trial: int = 0) -> NDArray[np.float64]:
+        """The next servo target (D,) for the reached `posture` (D,): encoded, one greedy latent
+        step of trial `trial`'s policy (clamped into the latent box), decoded."""
+        target, _, _ = self._policy(trial).act(np.ascontiguousarray(posture, dtype=np.float64))
+        return np.asarray(target)
+
+    def value(self, z: Any, trial: int = 0) -> NDArray[np.float64]:
+        """V(z) of trial `trial` at latent points `z` (M, d): the learner's own values."""
+        points = np.asarray(z, dtype=np.float64)
+        if points.ndim != 2 or points.shape[1] != len(self.latent_low):
+            raise ValueError(f"z must have shape (M, {len(self.latent_low)}), got {points.shape}")
+        return np.asarray(self._policy(trial).values(np.ascontiguousarray(points)))
+
+    def _policy(self, trial: int) -> _native.LatentPolicy:
+        if not (isinstance(trial, (int, np.integer)) and 0 <= trial < len(self._native)):
+            raise ValueError(f"trial must be an int in 0..{len(self._native) - 1}, got {trial!r}")
+        return self._native[int(trial)]
+
+    def rollout(self, episodes: int = 20, *, trial: int | None = None, seed: int = 0,
+                progress: Any = None) -> dict[str, Any]:
+        """Runs the greedy policy (no learning) for `episodes` episodes per trial (every trial,
+        or `trial`) from the task's start rule; returns the native dict (returns, ends, reached,
+        trajectories of every episode, …) plus "reached" as the fraction and "ends" as counts
+        per ending in "summary"."""
+        trials = range(len(self.weights)) if trial is None else [self._check_trial(trial)]
+        runs = []
+        for t in trials:
+            runs.append(_native.run_task_trials(
+                self.task._native, decoder=self.model.decoder_, encoder=self.model.encoder_,
+                latent_low=self.latent_low, latent_high=self.latent_high, demos=self.demos, n_trials=1,
+                episodes=episodes, base_seed=seed, first_trial=t, weights=self.weights[t], rollout=True,
+                record_episodes=list(range(min(episodes, 20))), progress=progress,
+            ))
+        ends = np.concatenate([r["ends"] for r in runs])
+        reached = np.concatenate([r["reached"] for r in runs])
+        names = end_reasons()
+        return {
+            "trials": list(trials),
+            "returns": np.concatenate([r["returns"] for r in runs]),
+            "ends": ends,
+            "reached": reached,
+            "paths": np.concatenate([r["trajectories"] for r in runs]),
+            "summary": {
+                "reached": float(reached.mean()),
+                "ends": {names[c]: int((ends == c).sum()) for c in range(len(names))},
+                "mean_return": float(np.concatenate([r["returns"] for r in runs]).mean()),
+            },
+        }
+
+    def _check_trial(self, trial: int) -> int:
+        self._policy(trial)
+        return int(trial)
+
+    def end_counts(self, last: int | None = None) -> dict[str, int]:
+        """How many of the (`last`) training episodes of all trials ended each way."""
+        ends = self.record["ends"] if last is None else self.record["ends"][:, -last:]
+        names = end_reasons()
+        return {names[int(c)]: int(n) for c, n in zip(*np.unique(ends, return_counts=True))}
+
+    def save(self, path: PathLike) -> None:
+        """Writes the policy to one NPZ file (atomically): the GPLVM, every trial's weights, the
+        latent box, the demos, the task (its keys, its folder and a hash of it and its URDF) and
+        the training record. No pickles."""
+        arrays: dict[str, Any] = {
+            "format": np.array("latentrl.LatentPolicy"),
+            "format_version": np.array(FORMAT_VERSION),
+            "task": np.array(json.dumps(self.task.to_dict(), allow_nan=True)),
+            "task_dir": np.array(str(self.task.base_dir.resolve())),
+            "task_digest": np.array(self.task.digest()),
+            "latent_low": self.latent_low,
+            "latent_high": self.latent_high,
+            "weights": self.weights,
+            "demos": self.demos,
+            **{f"record.{k}": v for k, v in self.record.items()},
+            **{f"model.{k}": v for k, v in self.model._arrays().items()},
+        }
+        atomic_write(path, lambda fh: np.savez(fh, **arrays))
+
+    @classmethod
+    def load(cls, path: PathLike) -> LatentPolicy:
+        """Reads a policy written by `save`; its task is rebuilt from the saved keys and folder and
+        must hash as when saved (a changed URDF is refused). Errors are ValueErrors naming the file."""
+        try:
+            arrays = read_npz(path)
+        except ValueError as err:
+            raise ValueError(f"{path}: {err}") from err
+        found = str(arrays["format"]) if "format" in arrays else None
+        if found != "latentrl.LatentPolicy":
+            raise ValueError(f"{path}: holds {found or 'no latentrl file'}, expected latentrl.LatentPolicy")
+        missing = [k for k in ("task", "task_dir", "task_digest", "latent_low", "latent_high", "weights", "demos")
+                   if k not in arrays]
+        if missing:
+            raise ValueError(f"{path}: not a complete policy file (missing {missing})")
+        task = Task.from_dict(json.loads(str(arrays["task"])), Path(str(arrays["task_dir"])), f"the task of {path}")
+        if task.digest() != str(arrays["task_digest"]):
+            raise ValueError(f"{path}: its task (or the task's URDF in {arrays['task_dir']}) changed since it was saved")
+        model = GPLVM._from_arrays({k[6:]: v for k, v in arrays.items() if k.startswith("model.")}, str(path))
+        record = {k[7:]: v for k, v in arrays.items() if k.startswith("record.")}
+        return cls(task=task, model=model, demos=arrays["demos"], latent_low=arrays["latent_low"],
+                   latent_high=arrays["latent_high"], weights=arrays["weights"], record=record)
+
+    def __repr__(self) -> str:
+        return f"LatentPolicy({self.task.name!r}, {len(self.weights)} trials, latent box {len(self.latent_low)}-D)"

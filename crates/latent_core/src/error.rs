@@ -65,6 +65,9 @@ pub enum CoreError {
         /// How many starts were drawn.
         draws: usize,
     },
+    /// A configuration value broke its rule ([`crate::params`]), named by its key path.
+    #[error(transparent)]
+    Param(#[from] crate::params::ParamError),
     /// A plant could not be built for a trial (e.g. a bad robot description); the
     /// plant's own error, as text.
     #[error("cannot build the plant: {reason}")]

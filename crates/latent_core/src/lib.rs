@@ -3,25 +3,32 @@
 //! every step in latent space. Pure Rust: no Python needed to use or test it.
 #![warn(missing_docs)]
 
+pub mod config;
 pub mod episode;
 pub mod error;
 pub mod gp;
 pub mod gplvm;
 pub mod kernel;
+pub mod learner;
+pub mod params;
+pub mod plant;
 pub mod policy;
 pub mod rbf;
+pub mod space;
 pub mod td;
 pub mod trials;
 
-pub use episode::{
-    EndReason, EpisodeRecord, EpisodeScratch, Learner, LearnerConfig, Phase, Plant, StartMode, StateSpace, StepOutcome,
-    StepResult,
-};
+pub use config::{ActionSet, LearnerConfig};
+pub use episode::{Bounds, EpisodeRecord, EpisodeScratch, StepResult, TransitionScratch, refused, transition};
 pub use error::{CoreError, Result};
 pub use gp::{GpMap, PredictScratch};
 pub use gplvm::{NllGrad, nll_grad};
 pub use kernel::{Factor, SeKernel, factorize};
-pub use policy::{SoftmaxPolicy, orthogonal_actions};
+pub use learner::{EpisodeRules, Learner, Phase, StartMode};
+pub use params::{Check, FieldInfo, Kind, ParamError, Params, Rule};
+pub use plant::{EndReason, Plant, StepOutcome};
+pub use policy::SoftmaxPolicy;
 pub use rbf::{RbfConfig, RbfGrid, SparseFeatures};
-pub use td::{TdConfig, TdLearner};
+pub use space::StateSpace;
+pub use td::TdLearner;
 pub use trials::{TrialOptions, TrialResult, run_trials, trial_rng};

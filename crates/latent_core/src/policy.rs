@@ -1,5 +1,5 @@
-//! Soft-max action selection (paper Eq. 10) over a discrete action set, and the usual
-//! action sets. The one-step look-ahead `Q(s, u_i) = V(s + δt · u_i)` (Eq. 11) is computed
+//! Soft-max action selection (paper Eq. 10) over a discrete action set (the usual sets:
+//! [`crate::ActionSet`]). The one-step look-ahead `Q(s, u_i) = V(s + δt · u_i)` (Eq. 11) is computed
 //! by the caller ([`crate::episode`]) and handed in as the slice `q`.
 
 use rand::{Rng, RngExt};
@@ -59,25 +59,6 @@ impl SoftmaxPolicy {
         // Rounding can leave u a hair above the last weight: take the last non-zero one.
         buffer.iter().rposition(|&w| w > 0.0).unwrap_or(0)
     }
-}
-
-/// The `2·dim` orthogonal unit actions `±e_k` as rows of a flat `(2·dim) × dim` array, in
-/// the order `+e_0, −e_0, +e_1, −e_1, …` (paper Exp. 1 latent learner: 4 actions in 2-D).
-pub fn orthogonal_actions(dim: usize) -> Vec<f64> {
-    let mut actions = vec![0.0; 2 * dim * dim];
-    for k in 0..dim {
-        actions[(2 * k) * dim + k] = 1.0;
-        actions[(2 * k + 1) * dim + k] = -1.0;
-    }
-    actions
-}
-
-/// The 8 actions of the paper's Exp. 2 in a 2-D latent space: the 4 orthogonal ones, then
-/// the 4 diagonals `(±1, ±1)` (√2 longer: each coordinate moves one full step).
-pub fn orthogonal_and_diagonal_actions_2d() -> Vec<f64> {
-    let mut actions = orthogonal_actions(2);
-    actions.extend_from_slice(&[1.0, 1.0, 1.0, -1.0, -1.0, 1.0, -1.0, -1.0]);
-    actions
 }
 
 /// Checks a flat action array: a non-empty whole number of rows of length `dim`, finite.
@@ -155,9 +136,7 @@ mod tests {
 
     #[test]
     fn action_sets() {
-        assert_eq!(orthogonal_actions(2), vec![1.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, -1.0]);
-        assert_eq!(orthogonal_and_diagonal_actions_2d().len(), 16);
-        assert_eq!(check_actions(&orthogonal_actions(3), 3).unwrap(), 6);
+        assert_eq!(check_actions(&[1.0, 0.0, 0.0, -1.0], 2).unwrap(), 2);
         assert!(check_actions(&[1.0, 2.0, 3.0], 2).is_err());
         assert!(check_actions(&[], 2).is_err());
         assert!(SoftmaxPolicy::new(0.0).is_err() && SoftmaxPolicy::new(f64::NAN).is_err());

@@ -4,44 +4,8 @@
 //! update `w ← w + α δ_t b(s_t)` (Eq. 9). A terminal transition (an episode ended by a
 //! penalty) uses `V(s_{t+1}) = 0`.
 
-use crate::error::{CoreError, Result, check_finite, check_positive};
+use crate::error::{CoreError, Result};
 use crate::rbf::SparseFeatures;
-
-/// Learning parameters; `Default` is the paper's Experiment 1 (α = 0.9, γ = 0.95, w₀ = 0).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TdConfig {
-    /// Learning rate α of Eq. 9 (paper: 0.9 for Exp. 1, 0.8 for Exp. 2); must be > 0.
-    pub alpha: f64,
-    /// Discount factor γ of Eq. 8 (paper: 0.95 for Exp. 1, 0.99 for Exp. 2); in [0, 1].
-    pub gamma: f64,
-    /// Every weight's initial value w₀ (paper-like: 0; optimistic knob: e.g. 1/(1 − γ)).
-    pub initial_weight: f64,
-}
-
-impl Default for TdConfig {
-    fn default() -> Self {
-        Self {
-            alpha: 0.9,
-            gamma: 0.95,
-            initial_weight: 0.0,
-        }
-    }
-}
-
-impl TdConfig {
-    /// Checks α > 0, 0 ≤ γ ≤ 1 and a finite w₀.
-    pub fn validate(&self) -> Result<()> {
-        check_positive("alpha (learning rate)", self.alpha)?;
-        if !(0.0..=1.0).contains(&self.gamma) {
-            return Err(CoreError::InvalidParameter {
-                name: "gamma (discount)",
-                value: self.gamma,
-                reason: "must lie in [0, 1]",
-            });
-        }
-        check_finite("initial_weight", &[self.initial_weight])
-    }
-}
 
 /// The weights `w` of `V(s) = wᵀ b(s)` and the TD(0) update (Eq. 7–9).
 #[derive(Debug, Clone)]
@@ -52,24 +16,38 @@ pub struct TdLearner {
 }
 
 impl TdLearner {
-    /// `n_features` weights set to `config.initial_weight`.
-    pub fn new(n_features: usize, config: &TdConfig) -> Result<Self> {
-        config.validate()?;
+    /// `n_features` weights set to `initial_weight`, learning rate `alpha` and discount `gamma`
+    /// (their rules are [`crate::LearnerConfig`]'s).
+    pub fn new(n_features: usize, alpha: f64, gamma: f64, initial_weight: f64) -> Result<Self> {
         if n_features == 0 {
             return Err(CoreError::Empty {
                 what: "value-function features",
             });
         }
         Ok(Self {
-            weights: vec![config.initial_weight; n_features],
-            alpha: config.alpha,
-            gamma: config.gamma,
+            weights: vec![initial_weight; n_features],
+            alpha,
+            gamma,
         })
     }
 
     /// The weights `w`, one per feature.
     pub fn weights(&self) -> &[f64] {
         &self.weights
+    }
+
+    /// Replaces `w` (e.g. with a saved policy's); its length must be the number of features.
+    pub fn set_weights(&mut self, weights: &[f64]) -> Result<()> {
+        if weights.len() != self.weights.len() {
+            return Err(CoreError::Shape {
+                what: "value weights",
+                expected: format!("({},)", self.weights.len()),
+                got: format!("({},)", weights.len()),
+            });
+        }
+        crate::error::check_finite("value weights", weights)?;
+        self.weights.copy_from_slice(weights);
+        Ok(())
     }
 
     /// Consumes the learner, returning `w`.
@@ -120,12 +98,7 @@ mod tests {
 
     #[test]
     fn update_follows_eq_8_and_9() {
-        let cfg = TdConfig {
-            alpha: 0.5,
-            gamma: 0.9,
-            initial_weight: 1.0,
-        };
-        let mut td = TdLearner::new(4, &cfg).unwrap();
+        let mut td = TdLearner::new(4, 0.5, 0.9, 1.0).unwrap();
         let b = features(&[(1, 0.25), (2, 0.75)]);
         assert_eq!(td.value(&b), 1.0);
         // δ = 0.3 + 0.9·2 − 1 = 1.1; w_i += 0.5·1.1·b_i.
@@ -139,14 +112,7 @@ mod tests {
 
     #[test]
     fn terminal_uses_zero_next_value() {
-        let mut td = TdLearner::new(
-            2,
-            &TdConfig {
-                initial_weight: 0.5,
-                ..TdConfig::default()
-            },
-        )
-        .unwrap();
+        let mut td = TdLearner::new(2, 0.9, 0.95, 0.5).unwrap();
         let b = features(&[(0, 1.0)]);
         let delta = td.update(&b, -1.0, None);
         assert!((delta - (-1.5)).abs() < 1e-15);
@@ -157,15 +123,7 @@ mod tests {
     fn converges_to_the_fixed_point_of_a_chain() {
         // Two states, one-hot features: s0 → s1 (r = 0), s1 → terminal (r = 1).
         // Fixed point: V(s1) = 1, V(s0) = γ.
-        let mut td = TdLearner::new(
-            2,
-            &TdConfig {
-                alpha: 0.3,
-                gamma: 0.9,
-                initial_weight: 0.0,
-            },
-        )
-        .unwrap();
+        let mut td = TdLearner::new(2, 0.3, 0.9, 0.0).unwrap();
         let (b0, b1) = (features(&[(0, 1.0)]), features(&[(1, 1.0)]));
         for _ in 0..200 {
             let v1 = td.value(&b1);
@@ -177,37 +135,7 @@ mod tests {
     }
 
     #[test]
-    fn rejects_bad_parameters() {
-        assert!(
-            TdLearner::new(
-                3,
-                &TdConfig {
-                    alpha: 0.0,
-                    ..Default::default()
-                }
-            )
-            .is_err()
-        );
-        assert!(
-            TdLearner::new(
-                3,
-                &TdConfig {
-                    gamma: 1.5,
-                    ..Default::default()
-                }
-            )
-            .is_err()
-        );
-        assert!(
-            TdLearner::new(
-                3,
-                &TdConfig {
-                    initial_weight: f64::INFINITY,
-                    ..Default::default()
-                }
-            )
-            .is_err()
-        );
-        assert!(TdLearner::new(0, &TdConfig::default()).is_err());
+    fn needs_a_feature() {
+        assert!(TdLearner::new(0, 0.9, 0.95, 0.0).is_err());
     }
 }

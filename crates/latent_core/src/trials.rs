@@ -19,8 +19,12 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use crate::episode::{EpisodeRecord, EpisodeScratch, Learner, Phase, Plant, StateSpace};
+use crate::episode::{EpisodeRecord, EpisodeScratch};
 use crate::error::{CoreError, Result};
+use crate::gp::GpMap;
+use crate::learner::{Learner, Phase};
+use crate::plant::Plant;
+use crate::space::StateSpace;
 
 /// The generator of trial `trial`: ChaCha8 seeded from `base_seed`, stream `trial`
 /// (2⁶⁴ independent streams per seed).
@@ -50,6 +54,9 @@ pub struct TrialOptions {
     pub test_episodes: usize,
     /// Test-episode indices (0-based) whose task-space trajectory is recorded.
     pub record_test_episodes: Vec<usize>,
+    /// The phase of the `episodes` ([`Phase::Train`]; [`Phase::Rollout`] runs a trained
+    /// template's greedy policy).
+    pub phase: Phase,
 }
 
 impl Default for TrialOptions {
@@ -63,6 +70,7 @@ impl Default for TrialOptions {
             keep_weights: false,
             test_episodes: 0,
             record_test_episodes: Vec::new(),
+            phase: Phase::Train,
         }
     }
 }
@@ -161,6 +169,53 @@ where
         .collect()
 }
 
+/// A latent space: the GPLVM maps and the latent box.
+#[derive(Debug, Clone, Copy)]
+pub struct LatentSpace<'a> {
+    /// Latent → posture GP map (GPLVM mean, Eq. 4).
+    pub decoder: &'a GpMap,
+    /// Posture → latent GP map (out-of-sample GP or back-constraint).
+    pub encoder: &'a GpMap,
+    /// Lower corner of the latent box.
+    pub low: &'a [f64],
+    /// Upper corner of the latent box.
+    pub high: &'a [f64],
+}
+
+impl<'a> LatentSpace<'a> {
+    /// The state space of these maps.
+    pub fn space(&self) -> StateSpace<'a> {
+        StateSpace::Latent {
+            decoder: self.decoder,
+            encoder: self.encoder,
+        }
+    }
+}
+
+/// Runs trials of the latent learner (`config`, `rules`; actions `config.actions`, RBF grid
+/// over the latent box) in `latent`, one plant per trial from `make_plant(trial)`: see
+/// [`run_trials`] for seeding, cancellation, progress and test episodes. A plant is built up
+/// front, so a bad plant or mismatched maps fail before any trial starts (a plant's error
+/// as [`CoreError::Plant`]).
+pub fn run_latent_trials<P, E, F>(
+    make_plant: F,
+    config: &crate::LearnerConfig,
+    rules: crate::EpisodeRules,
+    latent: &LatentSpace<'_>,
+    options: &TrialOptions,
+    cancel: &AtomicBool,
+    done: &AtomicUsize,
+) -> Result<Vec<TrialResult>>
+where
+    P: Plant,
+    E: std::fmt::Display,
+    F: Fn(usize) -> std::result::Result<P, E> + Sync,
+{
+    let make_plant = |trial| make_plant(trial).map_err(|e| CoreError::Plant { reason: e.to_string() });
+    let template = Learner::new(config, rules, latent.low, latent.high)?;
+    run_trials(&template, &latent.space(), make_plant, options, cancel, done)
+}
+
 fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
     template: &Learner,
     space: &StateSpace<'_>,
@@ -171,7 +226,8 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
     done: &AtomicUsize,
 ) -> Result<TrialResult> {
     let plant = make_plant(trial)?;
-    let learner = template.clone();
+    let mut learner = template.clone();
+    learner.set_phase(options.phase);
     let scratch = learner.scratch(space, plant.posture_dim());
     let rng = trial_rng(options.base_seed, trial);
     let mut run = TrialRun {

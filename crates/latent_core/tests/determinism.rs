@@ -4,10 +4,9 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-use latent_core::episode::StepOutcome;
 use latent_core::{
-    EndReason, Learner, LearnerConfig, Plant, RbfConfig, StartMode, StateSpace, TrialOptions, TrialResult,
-    orthogonal_actions, run_trials,
+    EndReason, EpisodeRules, Learner, LearnerConfig, Plant, StartMode, StateSpace, StepOutcome, TrialOptions,
+    TrialResult, run_trials,
 };
 use rand::{Rng, RngExt};
 
@@ -56,15 +55,15 @@ fn options() -> TrialOptions {
 
 fn run_on(threads: usize, options: &TrialOptions) -> Vec<TrialResult> {
     let config = LearnerConfig {
-        rbf: RbfConfig {
-            centres_per_dim: 11,
-            ..RbfConfig::default()
-        },
-        max_steps: 50,
-        start: StartMode::FromPlant,
+        rbf_per_dim: 11,
         ..LearnerConfig::default()
     };
-    let learner = Learner::new(&config, &[0.0], &[1.0], &orthogonal_actions(1)).unwrap();
+    let rules = EpisodeRules {
+        max_steps: 50,
+        start: StartMode::Plant,
+        ..EpisodeRules::default()
+    };
+    let learner = Learner::new(&config, rules, &[0.0], &[1.0]).unwrap();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let done = AtomicUsize::new(0);
     let results = pool

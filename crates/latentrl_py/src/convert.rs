@@ -4,6 +4,9 @@
 use nalgebra::{DMatrix, DVector};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use serde::Serialize;
+use serde::de::DeserializeOwned;
 
 use crate::errors::InvalidInputError;
 
@@ -13,9 +16,12 @@ pub fn points(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<DMatrix
     if n == 0 || q == 0 {
         return Err(InvalidInputError::new_err(format!("{name} is empty: shape ({n}, {q})")));
     }
-    let values: Vec<f64> = match array.as_slice() {
-        Ok(slice) => slice.to_vec(),
-        Err(_) => array.as_array().iter().copied().collect(),
+    // ndarray's `as_slice` is the row-major buffer only (numpy's would also hand out a
+    // Fortran-ordered one, whose memory order is the transpose).
+    let view = array.as_array();
+    let values: Vec<f64> = match view.as_slice() {
+        Some(slice) => slice.to_vec(),
+        None => view.iter().copied().collect(),
     };
     Ok(DMatrix::from_vec(q, n, values))
 }
@@ -37,4 +43,105 @@ pub fn to_points<'py>(py: Python<'py>, matrix: DMatrix<f64>) -> PyResult<Bound<'
 /// Vector → 1-D array, without copying the buffer.
 pub fn to_vector<'py>(py: Python<'py>, vector: DVector<f64>) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_vec(py, vector.data.into())
+}
+
+/// Borrowed names (joints, links) as Python strings.
+pub fn owned(names: Vec<&str>) -> Vec<String> {
+    names.into_iter().map(str::to_string).collect()
+}
+
+/// A configuration (`TaskConfig`, `LearnerConfig`, …) from a Python dict: read as the TOML
+/// value it stands for, then deserialised as a task file is, so a bad value gets the task
+/// file's message (`learner.gamma: invalid type: string "x", expected f64`), naming `what` and
+/// the key path. A None value is a key left out (TOML has no null).
+pub fn config_from<T: DeserializeOwned>(what: &str, value: &Bound<'_, PyAny>) -> PyResult<T> {
+    let fail = |path: &str, message: String| {
+        let at = if path == "." || path.is_empty() {
+            String::new()
+        } else {
+            format!("{path}: ")
+        };
+        InvalidInputError::new_err(format!("{what}: {at}{message}"))
+    };
+    if !value.is_instance_of::<PyDict>() {
+        let kind = value
+            .get_type()
+            .name()
+            .map_or_else(|_| "?".to_string(), |n| n.to_string());
+        return Err(fail("", format!("expected a dict of keys, got {kind}")));
+    }
+    let value = toml_value(value, "").map_err(|(path, message)| fail(&path, message))?;
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        fail(&path, e.into_inner().message().to_string())
+    })
+}
+
+/// A Python value as a TOML value, by its own type: a bool is never a number, a string never a
+/// bool (NumPy arrays and scalars through `tolist`). Err: (key path, what is wrong).
+fn toml_value(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, (String, String)> {
+    let join = |key: &str| {
+        if path.is_empty() {
+            key.to_string()
+        } else {
+            format!("{path}.{key}")
+        }
+    };
+    let wrong = |what: String| (path.to_string(), what);
+    if let Ok(b) = value.cast::<PyBool>() {
+        return Ok(toml::Value::Boolean(b.is_true()));
+    }
+    if value.is_instance_of::<PyInt>() {
+        let i: i64 = value
+            .extract()
+            .map_err(|_| wrong(format!("the integer {value} is too large")))?;
+        return Ok(toml::Value::Integer(i));
+    }
+    if let Ok(f) = value.cast::<PyFloat>() {
+        return Ok(toml::Value::Float(f.value()));
+    }
+    if let Ok(s) = value.cast::<PyString>() {
+        return Ok(toml::Value::String(s.to_string()));
+    }
+    if let Ok(map) = value.cast::<PyDict>() {
+        let mut table = toml::Table::new();
+        for (k, v) in map.iter() {
+            let key: String = k
+                .extract()
+                .map_err(|_| wrong(format!("a key must be a string, got {k}")))?;
+            if !v.is_none() {
+                let item = toml_value(&v, &join(&key))?;
+                table.insert(key, item);
+            }
+        }
+        return Ok(toml::Value::Table(table));
+    }
+    if value.hasattr("tolist").unwrap_or(false) && !value.is_instance_of::<PyList>() {
+        let plain = value.call_method0("tolist").map_err(|e| wrong(e.to_string()))?;
+        return toml_value(&plain, path);
+    }
+    if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
+        let items = value.try_iter().map_err(|e| wrong(e.to_string()))?;
+        let mut array = Vec::new();
+        for (i, item) in items.enumerate() {
+            let item = item.map_err(|e| wrong(e.to_string()))?;
+            if item.is_none() {
+                return Err(wrong(format!("item {i} is None")));
+            }
+            array.push(toml_value(&item, path)?);
+        }
+        return Ok(toml::Value::Array(array));
+    }
+    let kind = value
+        .get_type()
+        .name()
+        .map_or_else(|_| "?".to_string(), |n| n.to_string());
+    Err(wrong(format!(
+        "invalid type: {kind} {value}, expected a bool, number, string, list or dict"
+    )))
+}
+
+/// A configuration as a Python dict (nested tables as dicts, none as None).
+pub fn config_to<'py, T: Serialize>(py: Python<'py>, value: &T) -> PyResult<Bound<'py, PyAny>> {
+    pythonize::pythonize(py, value).map_err(|e| InvalidInputError::new_err(e.to_string()))
 }

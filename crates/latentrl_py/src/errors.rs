@@ -78,6 +78,7 @@ pub fn to_py(err: CoreError) -> PyErr {
         | CoreError::Empty { .. }
         | CoreError::InvalidParameter { .. }
         | CoreError::NoValidStart { .. }
+        | CoreError::Param(_)
         | CoreError::Plant { .. } => InvalidInputError::new_err(msg),
         CoreError::NotPositiveDefinite { .. } | CoreError::Overflow { .. } => NumericalError::new_err(msg),
     }
@@ -97,6 +98,8 @@ pub fn sim_to_py(err: SimError) -> PyErr {
         | SimError::UnknownJoint { .. }
         | SimError::UnknownLink { .. }
         | SimError::InvalidJointParameter { .. }
+        | SimError::Param(_)
+        | SimError::Task { .. }
         | SimError::UnknownObstacle { .. } => InvalidInputError::new_err(msg),
     }
 }

@@ -1,16 +1,15 @@
 //! `latentrl._native`: the module table. Each file converts one core module; nothing is decided here.
 #![allow(missing_docs)]
 
-mod arms;
+mod bimanual;
 mod convert;
 mod errors;
+mod fallcheck;
 mod gp;
-mod humanoid;
-mod lift;
-mod physics;
-mod rl;
-mod sim;
-mod simconfig;
+mod kinematics;
+mod runner;
+mod task;
+mod world;
 
 use pyo3::prelude::*;
 
@@ -18,15 +17,24 @@ use pyo3::prelude::*;
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     m.add_class::<gp::PyGpMap>()?;
-    m.add_class::<physics::PySim>()?;
+    m.add_class::<world::PySim>()?;
+    m.add_class::<task::PyTask>()?;
+    m.add_class::<task::PyTaskPlant>()?;
+    m.add_class::<task::PyLatentPolicy>()?;
+    m.add_class::<bimanual::PyBimanualPlant>()?;
     m.add_function(wrap_pyfunction!(gp::gplvm_nll_grad, m)?)?;
-    m.add_function(wrap_pyfunction!(sim::arms_fk, m)?)?;
-    m.add_function(wrap_pyfunction!(sim::arms_elbows, m)?)?;
-    m.add_function(wrap_pyfunction!(sim::arms_ik, m)?)?;
-    m.add_function(wrap_pyfunction!(humanoid::humanoid_fall_check, m)?)?;
-    m.add_function(wrap_pyfunction!(rl::run_bimanual_trials, m)?)?;
-    m.add_function(wrap_pyfunction!(arms::run_arms_trials, m)?)?;
-    m.add_function(wrap_pyfunction!(lift::run_lift_trials, m)?)?;
+    m.add_function(wrap_pyfunction!(kinematics::arms_fk, m)?)?;
+    m.add_function(wrap_pyfunction!(kinematics::arms_elbows, m)?)?;
+    m.add_function(wrap_pyfunction!(kinematics::arms_ik, m)?)?;
+    m.add_function(wrap_pyfunction!(fallcheck::fall_check, m)?)?;
+    m.add_function(wrap_pyfunction!(bimanual::run_bimanual_trials, m)?)?;
+    m.add_function(wrap_pyfunction!(bimanual::bimanual_config, m)?)?;
+    m.add_function(wrap_pyfunction!(bimanual::latent_refusal, m)?)?;
+    m.add_function(wrap_pyfunction!(task::bimanual_schema, m)?)?;
+    m.add_function(wrap_pyfunction!(task::run_task_trials, m)?)?;
+    m.add_function(wrap_pyfunction!(task::learner_values, m)?)?;
+    m.add_function(wrap_pyfunction!(task::task_schema, m)?)?;
+    m.add_function(wrap_pyfunction!(task::end_reasons, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,5 +1,6 @@
 //! Two planar arms on rapier3d 0.36.1: physics steps/s and RL steps/s (SPEC §4.2), and
-//! the Experiment 2 plant ([`sim::ArmsPlant`]) alone and inside a latent learner's step.
+//! the two-arms task's plant ([`sim::TaskPlant`], `tasks/two_arms.toml`) alone and inside a
+//! latent learner's step.
 //!
 //! Peers (PEERS.md): MuJoCo 4.1 µs per step (dt 2 ms), rapier's PyPI wheel 2.4 µs; MuJoCo on
 //! the same URDF and settings is measured side by side in `benches/bench_sim.py`.
@@ -7,18 +8,30 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use latent_core::{GpMap, Plant, SeKernel};
+use std::sync::Arc;
+
+use latent_core::trials::LatentSpace;
+use latent_core::{GpMap, Learner, Plant, SeKernel};
 use nalgebra::{DMatrix, Isometry3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use sim::arms::{ArmsConfig, ArmsLatent, ArmsPlant, learner_config};
-use sim::{Obstacle, ObstacleShape, PhysicsSim, PlanarArms, SimOptions, UrdfModel};
+use sim::{Obstacle, ObstacleShape, PhysicsConfig, PlanarArms, Task, TaskPlant, World, WorldConfig};
 
 const TWO_ARMS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/two_arms.urdf");
+const TASK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/tasks/two_arms.toml");
+
+/// The two-arms task with `iterations` solver iterations and the grip `tolerance`.
+fn task(iterations: usize, tolerance: f64) -> Arc<Task> {
+    let base = Task::load(TASK).expect("two_arms.toml loads");
+    let mut config = base.config().clone();
+    config.physics.solver_iterations = iterations;
+    config.constraints[0].tolerance = Some(tolerance);
+    Arc::new(Task::new(config, base.model().clone(), "two_arms").expect("a valid task"))
+}
 const START: [f64; 4] = [0.6, -1.2, 2.5, 1.2];
 
-fn arms(options: SimOptions) -> PhysicsSim {
-    let mut sim = PhysicsSim::from_urdf_file(TWO_ARMS, options).expect("two_arms.urdf loads");
+fn arms(options: WorldConfig) -> World {
+    let mut sim = World::from_urdf_file(TWO_ARMS, options).expect("two_arms.urdf loads");
     // The SPEC §4.2 corridor: two boxes, y ∈ [0.30, 0.37].
     for (x0, x1) in [(-1.0, -0.36), (-0.06, 1.0)] {
         let wall = Obstacle {
@@ -36,7 +49,7 @@ fn arms(options: SimOptions) -> PhysicsSim {
 }
 
 /// Alternating targets so the servos keep working (a still robot is cheaper).
-fn wiggle(sim: &mut PhysicsSim, k: usize) {
+fn wiggle(sim: &mut World, k: usize) {
     let d = if k.is_multiple_of(2) { 0.05 } else { -0.05 };
     let target = [START[0] + d, START[1] - d, START[2] + d, START[3] + d];
     sim.set_targets(&target).expect("finite targets");
@@ -53,10 +66,13 @@ fn physics_steps(c: &mut Criterion) {
         ("dt1/120_it4", 1.0 / 120.0, 4),
     ];
     for (label, dt, iterations) in settings {
-        let mut sim = arms(SimOptions {
-            dt,
-            solver_iterations: iterations,
-            ..SimOptions::default()
+        let mut sim = arms(WorldConfig {
+            physics: PhysicsConfig {
+                dt,
+                solver_iterations: iterations,
+                ..PhysicsConfig::default()
+            },
+            ..WorldConfig::default()
         });
         let mut k = 0;
         group.throughput(Throughput::Elements(100));
@@ -74,8 +90,8 @@ fn physics_steps(c: &mut Criterion) {
 
 fn rl_steps(c: &mut Criterion) {
     let mut group = c.benchmark_group("arms_rl_step");
-    let options = SimOptions::default();
-    let label = format!("substeps{}_dt1/240", options.substeps);
+    let options = WorldConfig::default();
+    let label = format!("substeps{}_dt1/240", options.physics.substeps);
     let mut sim = arms(options);
     let left = sim.frame("left_hand", [0.0; 3]).expect("hand frame");
     let right = sim.frame("right_hand", [0.0; 3]).expect("hand frame");
@@ -105,22 +121,14 @@ fn holding(x: f64, y: f64) -> [f64; 4] {
         .expect("reachable")
 }
 
-/// One `Plant::step` of the Experiment 2 plant (targets, sub-steps, joints, hands, walls,
-/// reward) at 2 (our default) and 4 solver iterations.
+/// One `Plant::step` of the two-arms task's plant (targets, sub-steps, joints, hands, walls,
+/// grip, reward) at 2 (the task's) and 4 solver iterations.
 fn arms_plant_steps(c: &mut Criterion) {
     let mut group = c.benchmark_group("arms_plant_step");
     group.throughput(Throughput::Elements(1));
-    let model = UrdfModel::from_file(TWO_ARMS).expect("two_arms.urdf loads");
     let start = holding(-0.2, 0.2);
     for iterations in [2, 4] {
-        let config = ArmsConfig {
-            sim: SimOptions {
-                solver_iterations: iterations,
-                ..SimOptions::default()
-            },
-            ..ArmsConfig::default()
-        };
-        let mut plant = ArmsPlant::new(model.clone(), config).expect("plant builds");
+        let mut plant = TaskPlant::new(task(iterations, 0.005), None).expect("plant builds");
         plant.reset(&start);
         let targets = [holding(-0.19, 0.2), holding(-0.2, 0.2)];
         let mut reached = [0.0; 4];
@@ -151,19 +159,17 @@ fn arms_learner_step(c: &mut Criterion) {
     let kernel = SeKernel::new([1.0, 0.1, 1e-6]).expect("valid kernel");
     let decoder = GpMap::new(z.clone(), x.clone(), kernel).expect("decoder");
     let encoder = GpMap::new(x, z, kernel).expect("encoder");
-    let latent = ArmsLatent {
+    let latent = LatentSpace {
         decoder: &decoder,
         encoder: &encoder,
         low: &[0.0, 0.0],
         high: &[1.0, 1.0],
     };
-    let config = ArmsConfig {
-        drop_tolerance: 0.02,
-        ..ArmsConfig::default()
-    };
-    let model = UrdfModel::from_file(TWO_ARMS).expect("two_arms.urdf loads");
-    let mut plant = ArmsPlant::new(model, config).expect("plant builds");
-    let (mut learner, space) = latent.build(&learner_config(), 4).expect("learner");
+    let task = task(2, 0.02);
+    let mut plant = TaskPlant::new(Arc::clone(&task), None).expect("plant builds");
+    let space = latent.space();
+    let mut learner =
+        Learner::new(&task.config().learner, task.episode_rules(), latent.low, latent.high).expect("learner");
     let mut scratch = learner.scratch(&space, 4);
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     learner

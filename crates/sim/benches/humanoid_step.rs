@@ -1,7 +1,7 @@
 //! The KHR-1HV-like humanoid on rapier3d 0.36.1: physics steps/s of the free-floating robot
 //! standing on the ground under servo PD (SPEC §4.3; kp 8 N·m/rad, kd 0.1 N·m·s/rad, ±1.2 N·m,
 //! dt 1/240), at its home posture and at the first lift demo, with the humanoid's physics
-//! (1 solver iteration of 4 PGS passes, `latentrl.humanoid.PHYSICS`) and rapier's default
+//! (1 solver iteration of 4 PGS passes, `tasks/humanoid_lift.toml`) and rapier's default
 //! (4 iterations of 1 pass).
 //!
 //! Peer: MuJoCo on the same URDF, measured side by side in `benches/bench_sim.py`.
@@ -9,10 +9,14 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use sim::humanoid::{reset_on_ground, sim_options};
-use sim::{PhysicsSim, SimOptions, UrdfModel};
+use sim::fall::reset_on_ground;
+use sim::{PhysicsConfig, Task, UrdfModel, World, WorldConfig};
 
 const KHR1HV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/khr1hv.urdf");
+const TASK: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../python/latentrl/tasks/humanoid_lift.toml"
+);
 const DEMOS: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../../python/latentrl/data/khr1hv_lift_demos.csv"
@@ -23,14 +27,18 @@ const STEPS: usize = 10;
 /// standing 10 s, so every timed step is of a standing robot.
 const RESTART_AFTER: f64 = 10.0;
 
-/// The humanoid of `sim::humanoid::sim_options` with `(solver iterations, PGS passes)`.
-fn humanoid((solver_iterations, pgs_iterations): (usize, usize)) -> PhysicsSim {
-    let options = SimOptions {
-        solver_iterations,
-        pgs_iterations,
-        ..sim_options()
+/// The humanoid in the world of the lift task with `(solver iterations, PGS passes)`.
+fn humanoid((solver_iterations, pgs_iterations): (usize, usize)) -> World {
+    let world = Task::load(TASK).expect("humanoid_lift.toml loads").world_config();
+    let options = WorldConfig {
+        physics: PhysicsConfig {
+            solver_iterations,
+            pgs_iterations,
+            ..world.physics.clone()
+        },
+        ..world
     };
-    PhysicsSim::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
+    World::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
 }
 
 /// The first pose of the shipped (centred) lift demos: hip-hinge, straight arms.
@@ -52,9 +60,8 @@ fn physics_steps(c: &mut Criterion) {
     ];
     for (label, posture, iterations) in settings {
         let mut sim = humanoid(iterations);
-        let start = |sim: &mut PhysicsSim| {
-            reset_on_ground(sim, posture, "l_foot", 0.0, 5e-4).expect("start posture within limits")
-        };
+        let start =
+            |sim: &mut World| reset_on_ground(sim, posture, "l_foot", 0.0, 5e-4).expect("start posture within limits");
         start(&mut sim);
         group.bench_function(BenchmarkId::from_parameter(label), |b| {
             b.iter(|| {

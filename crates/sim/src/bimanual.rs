@@ -16,93 +16,66 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
-use latent_core::GpMap;
-use latent_core::episode::{EndReason, Learner, LearnerConfig, Plant, StateSpace, StepOutcome};
-use latent_core::error::{CoreError, Result, check_finite, check_positive};
-use latent_core::policy::orthogonal_actions;
+use latent_core::error::Result;
+use latent_core::params::{ParamError, Params, Rule};
 use latent_core::trials::{TrialOptions, TrialResult, run_trials};
+use latent_core::{EndReason, EpisodeRules, GpMap, Learner, LearnerConfig, Plant, StateSpace, StepOutcome, params};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-/// Everything about the Experiment 1 plant; `Default` is SPEC §4.1.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BimanualConfig {
-    /// Drop tolerance on `‖(x_R − x_L) − grip‖` (SPEC default for RL: 0.1, about one RBF
-    /// spacing; Table I and the paper-strict variant: 0.005).
-    pub drop_tolerance: f64,
-    /// The held object's offset `x_R − x_L` (paper: (0.1, 0), no rotation).
-    pub grip: [f64; 2],
-    /// Centre of the disc obstacle neither hand may enter (ours: (0.5, 0.5)).
-    pub obstacle_centre: [f64; 2],
-    /// Radius of the disc obstacle (ours: 0.2); 0 removes it.
-    pub obstacle_radius: f64,
-    /// Lower bound of each hand coordinate (state box `[low, high]²` per hand; ours: −0.5).
-    pub box_low: f64,
-    /// Upper bound of each hand coordinate (ours: 1.5).
-    pub box_high: f64,
-    /// Target `x* = (x_L, y_L, x_R, y_R)` of the reward (paper: (0, 0, 0.1, 0)).
-    pub target: [f64; 4],
-    /// θ of the reward `exp(−θ ‖x − x*‖²)` (Eq. 12; paper: 0.75).
-    pub theta: f64,
-    /// Mean of the left hand's start position (paper: (1, 1)).
-    pub start_mean: [f64; 2],
-    /// Standard deviation of the left hand's start position per coordinate (paper: 0.1);
-    /// the right hand starts at left + grip.
-    pub start_sd: f64,
-    /// Penalty R_p added when a step hits the obstacle, leaves the box or drops (paper: −1).
-    pub penalty: f64,
-    /// "Reached the target": RMS per-hand distance to `x*` at most this (SPEC: 0.1).
-    pub reached_rms: f64,
+params! {
+    /// Everything about the Experiment 1 plant and its episodes; `Default` is SPEC §4.1.
+    pub struct BimanualConfig {
+        /// Drop tolerance on ‖(x_R − x_L) − grip‖ (SPEC default for RL: 0.1, about one RBF
+        /// spacing; Table I and the paper-strict variant: 0.005).
+        drop_tolerance: f64 = 0.1 => Rule::Positive,
+        /// The held object's offset x_R − x_L (paper: (0.1, 0), no rotation).
+        grip: [f64; 2] = [0.1, 0.0] => Rule::Finite,
+        /// Centre of the disc obstacle neither hand may enter (ours: (0.5, 0.5)).
+        obstacle_centre: [f64; 2] = [0.5, 0.5] => Rule::Finite,
+        /// Radius of the disc obstacle (ours: 0.2); 0 removes it.
+        obstacle_radius: f64 = 0.2 => Rule::NonNegative,
+        /// Lower bound of each hand coordinate (state box [low, high]² per hand; ours: −0.5).
+        box_low: f64 = -0.5 => Rule::Finite,
+        /// Upper bound of each hand coordinate (ours: 1.5).
+        box_high: f64 = 1.5 => Rule::Finite,
+        /// Target x* = (x_L, y_L, x_R, y_R) of the reward (paper: (0, 0, 0.1, 0)).
+        target: [f64; 4] = [0.0, 0.0, 0.1, 0.0] => Rule::Finite,
+        /// θ of the reward exp(−θ ‖x − x*‖²) (Eq. 12; paper: 0.75).
+        theta: f64 = 0.75 => Rule::Positive,
+        /// Mean of the left hand's start position (paper: (1, 1)).
+        start_mean: [f64; 2] = [1.0, 1.0] => Rule::Finite,
+        /// Standard deviation of the left hand's start position per coordinate (paper: 0.1);
+        /// the right hand starts at left + grip.
+        start_sd: f64 = 0.1 => Rule::NonNegative,
+        /// Penalty R_p added when a step hits the obstacle, leaves the box or drops (paper: −1).
+        penalty: f64 = -1.0 => Rule::closed(-1e6, 1e6),
+        /// "Reached the target": RMS per-hand distance to x* at most this (SPEC: 0.1).
+        reach_radius: f64 = 0.1 => Rule::Positive,
+        /// Steps per episode before a time-out (paper: 500).
+        max_steps: usize = 500 => Rule::count(1, 1_000_000),
+    }
+    check = box_order;
 }
 
-impl Default for BimanualConfig {
-    fn default() -> Self {
-        Self {
-            drop_tolerance: 0.1,
-            grip: [0.1, 0.0],
-            obstacle_centre: [0.5, 0.5],
-            obstacle_radius: 0.2,
-            box_low: -0.5,
-            box_high: 1.5,
-            target: [0.0, 0.0, 0.1, 0.0],
-            theta: 0.75,
-            start_mean: [1.0, 1.0],
-            start_sd: 0.1,
-            penalty: -1.0,
-            reached_rms: 0.1,
-        }
+fn box_order(c: &BimanualConfig, path: &str) -> std::result::Result<(), ParamError> {
+    if c.box_high <= c.box_low {
+        return Err(ParamError::new(
+            &latent_core::params::join(path, "box_high"),
+            format!("must exceed box_low = {}, got {}", c.box_low, c.box_high),
+        ));
     }
+    Ok(())
 }
 
 impl BimanualConfig {
-    /// Checks every field: finite values, positive tolerances, `box_low < box_high`.
-    pub fn validate(&self) -> Result<()> {
-        check_positive("drop_tolerance", self.drop_tolerance)?;
-        check_finite("grip", &self.grip)?;
-        check_finite("obstacle_centre", &self.obstacle_centre)?;
-        check_finite("target", &self.target)?;
-        check_finite("start_mean", &self.start_mean)?;
-        check_finite("penalty", &[self.penalty])?;
-        check_positive("theta (reward width)", self.theta)?;
-        check_positive("reached_rms", self.reached_rms)?;
-        for (name, value) in [("obstacle_radius", self.obstacle_radius), ("start_sd", self.start_sd)] {
-            if !(value.is_finite() && value >= 0.0) {
-                return Err(CoreError::InvalidParameter {
-                    name,
-                    value,
-                    reason: "must be finite and >= 0",
-                });
-            }
+    /// The learner's episode rules: the plant's own (Gaussian) start, length and penalty.
+    pub fn episode_rules(&self) -> EpisodeRules {
+        EpisodeRules {
+            max_steps: self.max_steps,
+            penalty: self.penalty,
+            ..EpisodeRules::default()
         }
-        check_finite("box_low/box_high", &[self.box_low, self.box_high])?;
-        if self.box_high <= self.box_low {
-            return Err(CoreError::InvalidParameter {
-                name: "box_high",
-                value: self.box_high,
-                reason: "must exceed box_low",
-            });
-        }
-        Ok(())
     }
 
     /// The state box as `(low, high)` corners in posture space (4-D).
@@ -155,10 +128,8 @@ impl BimanualPlant {
     pub fn new(config: BimanualConfig) -> Result<Self> {
         config.validate()?;
         let [x, y] = config.start_mean;
-        Ok(Self {
-            config,
-            state: [x, y, x + config.grip[0], y + config.grip[1]],
-        })
+        let state = [x, y, x + config.grip[0], y + config.grip[1]];
+        Ok(Self { config, state })
     }
 
     /// Its configuration.
@@ -210,7 +181,7 @@ impl Plant for BimanualPlant {
     }
 
     fn reached_target(&self) -> bool {
-        self.config.rms_hand_distance(&self.state) <= self.config.reached_rms
+        self.config.rms_hand_distance(&self.state) <= self.config.reach_radius
     }
 }
 
@@ -232,7 +203,8 @@ pub fn full_space_actions() -> Vec<f64> {
 pub enum BimanualLearner<'a> {
     /// Full 4-D space: 12 actions, RBF grid over the plant's state box.
     Full,
-    /// Latent space: `2d` orthogonal actions, RBF grid over `[low, high]` (d-D).
+    /// Latent space: the actions of the learner's config (Exp. 1: the 2d axes), RBF grid over
+    /// `[low, high]` (d-D).
     Latent {
         /// Latent → posture GP map (GPLVM mean, Eq. 4).
         decoder: &'a GpMap,
@@ -252,10 +224,8 @@ impl<'a> BimanualLearner<'a> {
         match *self {
             Self::Full => {
                 let (low, high) = plant.posture_box();
-                Ok((
-                    Learner::new(config, &low, &high, &full_space_actions())?,
-                    StateSpace::Full,
-                ))
+                let learner = Learner::with_actions(config, plant.episode_rules(), &low, &high, &full_space_actions())?;
+                Ok((learner, StateSpace::Full))
             }
             Self::Latent {
                 decoder,
@@ -263,7 +233,7 @@ impl<'a> BimanualLearner<'a> {
                 low,
                 high,
             } => {
-                let learner = Learner::new(config, low, high, &orthogonal_actions(low.len()))?;
+                let learner = Learner::new(config, plant.episode_rules(), low, high)?;
                 let space = StateSpace::Latent { decoder, encoder };
                 learner.check_space(&space, 4)?;
                 Ok((learner, space))
@@ -283,7 +253,14 @@ pub fn run_bimanual_trials(
     done: &AtomicUsize,
 ) -> Result<Vec<TrialResult>> {
     let (template, space) = learner.build(plant, config)?;
-    run_trials(&template, &space, |_| BimanualPlant::new(*plant), options, cancel, done)
+    run_trials(
+        &template,
+        &space,
+        |_| BimanualPlant::new(plant.clone()),
+        options,
+        cancel,
+        done,
+    )
 }
 
 #[cfg(test)]
@@ -307,7 +284,7 @@ mod tests {
         assert_eq!(c.violation(&[1.0, 1.0, 1.19, 1.0]), None, "within the 0.1 tolerance");
         let strict = BimanualConfig {
             drop_tolerance: 0.005,
-            ..c
+            ..c.clone()
         };
         assert_eq!(strict.violation(&[1.0, 1.0, 1.11, 1.0]), Some(EndReason::Drop));
         assert_eq!(c.reward(&c.target), 1.0);

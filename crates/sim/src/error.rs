@@ -92,6 +92,17 @@ pub enum SimError {
         /// What it must satisfy.
         reason: String,
     },
+    /// A configuration value broke its rule, named by its key path (`physics.dt`).
+    #[error(transparent)]
+    Param(#[from] latent_core::ParamError),
+    /// A task (file or dict) is unusable: a key, a value, or a name the robot lacks.
+    #[error("{origin}: {reason}")]
+    Task {
+        /// Where the task came from: its file, or what the caller named it.
+        origin: String,
+        /// What was wrong, starting with the key path.
+        reason: String,
+    },
     /// An obstacle id that was never returned by `add_obstacle`.
     #[error("unknown obstacle id {id}; the world has {count} obstacles")]
     UnknownObstacle {

@@ -1,25 +1,26 @@
-//! `sim`: the plants latentrl learns to control.
+//! `sim`: the plants latentrl learns to control — any URDF robot in a rapier3d world as a
+//! [`task::Task`] ([`task::TaskPlant`]), and Experiment 1's kinematic toy ([`bimanual`]).
 #![warn(missing_docs)]
 
-pub mod arms;
 pub mod bimanual;
 pub mod error;
-pub mod humanoid;
+pub mod fall;
+pub mod fallcheck;
 pub mod kinematics;
-pub mod latent;
-pub mod lift;
 pub mod obstacles;
 pub mod pd;
-pub mod plant;
+mod pose;
+pub mod shapes;
+pub mod task;
 pub mod urdf;
+pub mod world;
 
-pub use arms::{ArmsConfig, ArmsLatent, ArmsPlant, Wall};
 pub use bimanual::{BimanualConfig, BimanualLearner, BimanualPlant};
 pub use error::SimError;
+pub use fall::{FallCriteria, FallStatus};
 pub use kinematics::{ArmsPose, PlanarArms};
-pub use latent::Latent2d;
-pub use lift::{LiftConfig, LiftPlant};
-pub use obstacles::{Contact, FallCriteria, FallStatus, Obstacle, ObstacleId, ObstacleShape};
 pub use pd::PdGains;
-pub use plant::{Frame, PhysicsSim, SimOptions};
+pub use shapes::{Contact, Obstacle, ObstacleId, ObstacleShape};
+pub use task::{Task, TaskConfig, TaskPlant};
 pub use urdf::{JointInfo, JointKind, RootMode, UrdfModel};
+pub use world::{Frame, PhysicsConfig, ServoConfig, World, WorldConfig};

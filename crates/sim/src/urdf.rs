@@ -2,14 +2,14 @@
 //!
 //! [`UrdfModel`] parses a file or a string (with the `urdf-rs` version that
 //! rapier3d-urdf 0.36.1 re-exports), rejects what the physics plant cannot simulate,
-//! and lists the actuated joints in URDF order. [`crate::plant::PhysicsSim`] then inserts
+//! and lists the actuated joints in URDF order. [`crate::world::World`] then inserts
 //! it into a rapier world as one multibody (reduced coordinates).
 //!
 //! What rapier3d-urdf 0.36.1 ignores, and what we do about it:
 //! - `<dynamics damping friction>`: read here ([`JointInfo::damping`], [`JointInfo::friction`])
 //!   and written into the multibody's per-DoF damping / dry friction by the plant.
 //! - `limit.effort`: read here ([`JointInfo::effort`]) and used as the PD torque cap
-//!   (see [`crate::plant::SimOptions::use_urdf_effort`]).
+//!   (see [`crate::world::ServoConfig::use_urdf_effort`]).
 //! - `limit.velocity`: read ([`JointInfo::velocity`]) but **not enforced**.
 //! - `<mimic>`, `<safety_controller>`: rejected (mimic) or ignored (safety controller).
 //! - `<visual>`: ignored; only `<collision>` shapes become colliders. Meshes need cargo
@@ -21,6 +21,7 @@
 
 use std::path::Path;
 
+use latent_core::choice;
 use rapier3d_urdf::urdf_rs;
 
 use crate::error::{Result, SimError};
@@ -28,16 +29,24 @@ use crate::error::{Result, SimError};
 mod check;
 mod insert;
 use check::{check_joint_types, check_robot};
-pub(crate) use insert::{JointSlot, to_isometry};
+pub(crate) use insert::JointSlot;
 
-/// How the root link of the robot is attached to the world.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum RootMode {
-    /// The root link is welded to the world (arms on a fixed base).
-    #[default]
-    Fixed,
-    /// The root link floats freely with 6 DoF (a humanoid standing on the ground).
-    Floating,
+choice! {
+    /// How the root link of the robot is attached to the world.
+    pub enum RootMode {
+        /// The root link is welded to the world (arms on a fixed base).
+        Fixed = "fixed",
+        /// The root link floats freely with 6 DoF (a humanoid standing on a floor).
+        Floating = "floating",
+    }
+}
+
+// `choice!` declares the enum; its variants take no `#[default]`.
+#[allow(clippy::derivable_impls)]
+impl Default for RootMode {
+    fn default() -> Self {
+        Self::Fixed
+    }
 }
 
 /// Kind of an actuated (one-DoF) joint.
@@ -72,6 +81,21 @@ pub struct JointInfo {
     pub damping: Option<f64>,
     /// `<dynamics friction>` if given (N·m), applied as dry joint friction.
     pub friction: Option<f64>,
+}
+
+/// One collision shape of a link, as the URDF gives it (for drawing; the physics builds its
+/// colliders from the same elements).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShapeInfo {
+    /// Index of the link (URDF order).
+    pub link: usize,
+    /// "box", "sphere", "cylinder" or "capsule" (axis z), or "mesh".
+    pub kind: &'static str,
+    /// box: the 3 side lengths; sphere: the radius; cylinder, capsule: radius and length; mesh:
+    /// the scale.
+    pub size: Vec<f64>,
+    /// Pose of the shape in its link's frame.
+    pub origin: nalgebra::Isometry3<f64>,
 }
 
 /// A parsed and checked URDF robot.
@@ -156,6 +180,39 @@ impl UrdfModel {
     /// Names of every URDF link (including body-less frames such as hands), in URDF order.
     pub fn link_names(&self) -> Vec<&str> {
         self.robot.links.iter().map(|l| l.name.as_str()).collect()
+    }
+
+    /// Every collision shape, link by link in URDF order.
+    pub fn collision_shapes(&self) -> Vec<ShapeInfo> {
+        let mut out = Vec::new();
+        for (link, l) in self.robot.links.iter().enumerate() {
+            for c in &l.collision {
+                let (kind, size) = match &c.geometry {
+                    urdf_rs::Geometry::Box { size } => ("box", size.0.to_vec()),
+                    urdf_rs::Geometry::Sphere { radius } => ("sphere", vec![*radius]),
+                    urdf_rs::Geometry::Cylinder { radius, length } => ("cylinder", vec![*radius, *length]),
+                    urdf_rs::Geometry::Capsule { radius, length } => ("capsule", vec![*radius, *length]),
+                    urdf_rs::Geometry::Mesh { scale, .. } => ("mesh", scale.map_or(vec![1.0; 3], |s| s.0.to_vec())),
+                };
+                out.push(ShapeInfo {
+                    link,
+                    kind,
+                    size,
+                    origin: crate::pose::origin_pose(&c.origin),
+                });
+            }
+        }
+        out
+    }
+
+    /// `(parent link, child link)` of every URDF joint, fixed ones included: the kinematic
+    /// tree, e.g. to draw it.
+    pub fn edges(&self) -> Vec<(&str, &str)> {
+        self.robot
+            .joints
+            .iter()
+            .map(|j| (j.parent.link.as_str(), j.child.link.as_str()))
+            .collect()
     }
 
     /// Index of the URDF link called `name`, or [`SimError::UnknownLink`].

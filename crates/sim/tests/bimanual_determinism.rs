@@ -21,9 +21,15 @@ fn options() -> TrialOptions {
 
 fn config() -> LearnerConfig {
     LearnerConfig {
-        max_steps: 80,
-        step_fraction: 0.5,
+        step: 0.5,
         ..LearnerConfig::default()
+    }
+}
+
+fn plant() -> BimanualConfig {
+    BimanualConfig {
+        max_steps: 80,
+        ..BimanualConfig::default()
     }
 }
 
@@ -31,16 +37,7 @@ fn run_on(threads: usize, learner: &BimanualLearner<'_>, options: &TrialOptions)
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let done = AtomicUsize::new(0);
     let results = pool
-        .install(|| {
-            run_bimanual_trials(
-                &BimanualConfig::default(),
-                &config(),
-                learner,
-                options,
-                &AtomicBool::new(false),
-                &done,
-            )
-        })
+        .install(|| run_bimanual_trials(&plant(), &config(), learner, options, &AtomicBool::new(false), &done))
         .unwrap();
     assert_eq!(done.load(Ordering::Relaxed), options.n_trials * options.episodes);
     results
@@ -104,15 +101,7 @@ fn a_trial_is_the_same_alone_or_in_a_sweep() {
 fn cancel_stops_every_trial_unfinished() {
     let cancel = AtomicBool::new(true);
     let done = AtomicUsize::new(0);
-    let r = run_bimanual_trials(
-        &BimanualConfig::default(),
-        &config(),
-        &BimanualLearner::Full,
-        &options(),
-        &cancel,
-        &done,
-    )
-    .unwrap();
+    let r = run_bimanual_trials(&plant(), &config(), &BimanualLearner::Full, &options(), &cancel, &done).unwrap();
     assert!(r.iter().all(|t| !t.finished && t.episodes.is_empty()));
     assert_eq!(done.load(Ordering::Relaxed), 0);
 }

@@ -7,7 +7,7 @@ mod common;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
-use latent_core::{EndReason, LearnerConfig, TdConfig, TrialOptions, TrialResult};
+use latent_core::{EndReason, LearnerConfig, TrialOptions, TrialResult};
 use sim::bimanual::{BimanualConfig, BimanualLearner, run_bimanual_trials};
 
 /// α of the non-learning control.
@@ -28,13 +28,13 @@ fn run(
     alpha: f64,
 ) -> Vec<TrialResult> {
     let config = LearnerConfig {
-        max_steps: 200,
-        step_fraction,
-        td: TdConfig {
-            alpha,
-            ..TdConfig::default()
-        },
+        step: step_fraction,
+        alpha,
         ..LearnerConfig::default()
+    };
+    let plant = BimanualConfig {
+        max_steps: 200,
+        ..plant.clone()
     };
     let options = TrialOptions {
         n_trials: 2,
@@ -43,7 +43,7 @@ fn run(
         ..Default::default()
     };
     run_bimanual_trials(
-        plant,
+        &plant,
         &config,
         learner,
         &options,

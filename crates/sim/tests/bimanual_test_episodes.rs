@@ -13,20 +13,15 @@ fn run(options: &TrialOptions, cancel: bool) -> Vec<TrialResult> {
     let (decoder, encoder) = common::synthetic_maps();
     let learner = common::latent_learner(&decoder, &encoder);
     let config = LearnerConfig {
-        max_steps: 60,
-        step_fraction: 0.5,
+        step: 0.5,
         ..LearnerConfig::default()
     };
+    let plant = BimanualConfig {
+        max_steps: 60,
+        ..BimanualConfig::default()
+    };
     let done = AtomicUsize::new(0);
-    let r = run_bimanual_trials(
-        &BimanualConfig::default(),
-        &config,
-        &learner,
-        options,
-        &AtomicBool::new(cancel),
-        &done,
-    )
-    .unwrap();
+    let r = run_bimanual_trials(&plant, &config, &learner, options, &AtomicBool::new(cancel), &done).unwrap();
     if !cancel {
         assert_eq!(
             done.into_inner(),

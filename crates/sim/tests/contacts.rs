@@ -5,7 +5,7 @@ use latent_core::CoreError;
 use std::f64::consts::FRAC_PI_2;
 
 use nalgebra::Isometry3;
-use sim::{Contact, Obstacle, ObstacleShape, SimError, SimOptions};
+use sim::{Contact, Obstacle, ObstacleShape, SimError, WorldConfig};
 
 /// Both arms straight up (+y): the left arm lies on x = −0.15, y ∈ [0, 0.6].
 const UP: [f64; 4] = [FRAC_PI_2, 0.0, FRAC_PI_2, 0.0];
@@ -23,7 +23,7 @@ fn block(x: f64, y: f64, sensor: bool) -> Obstacle {
 
 #[test]
 fn arm_driven_into_a_box_touches_it_and_a_far_box_is_untouched() {
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     let near = sim.add_obstacle(block(-0.35, 0.45, false)).unwrap();
     let far = sim.add_obstacle(block(1.0, 1.0, false)).unwrap();
     sim.reset(&UP).unwrap();
@@ -55,7 +55,7 @@ fn arm_driven_into_a_box_touches_it_and_a_far_box_is_untouched() {
 
 #[test]
 fn sensor_obstacle_reports_overlap_without_blocking() {
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     let id = sim.add_obstacle(block(-0.35, 0.45, true)).unwrap();
     sim.reset(&UP).unwrap();
     assert!(!sim.touching("left_forearm", id).unwrap());
@@ -71,7 +71,7 @@ fn sensor_obstacle_reports_overlap_without_blocking() {
 
 #[test]
 fn contacts_follow_a_reset_at_once() {
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     let id = sim.add_obstacle(block(-0.15, 0.3, true)).unwrap();
     sim.reset(&UP).unwrap();
     assert!(sim.touching("left_upper_arm", id).unwrap());
@@ -96,15 +96,15 @@ fn contacts_follow_a_reset_at_once() {
 
 #[test]
 fn ground_contact_and_bad_obstacles() {
-    let options = SimOptions {
-        ground: Some(-0.01),
-        ..SimOptions::default()
+    let options = WorldConfig {
+        floor: Some(-0.01),
+        ..WorldConfig::default()
     };
     let mut sim = common::arms(options);
     sim.step(2);
     assert!(sim.touching_ground("left_forearm").unwrap());
     assert!(
-        !common::arms(SimOptions::default())
+        !common::arms(WorldConfig::default())
             .touching_ground("left_forearm")
             .unwrap()
     );

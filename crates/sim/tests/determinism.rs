@@ -2,10 +2,10 @@
 mod common;
 
 use nalgebra::Isometry3;
-use sim::{Obstacle, ObstacleShape, PhysicsSim, SimOptions};
+use sim::{Obstacle, ObstacleShape, World, WorldConfig};
 
 fn run(seed: u64) -> Vec<u64> {
-    let mut sim: PhysicsSim = common::arms(SimOptions::default());
+    let mut sim: World = common::arms(WorldConfig::default());
     let obstacle = Obstacle {
         name: "wall".to_string(),
         shape: ObstacleShape::Box {
@@ -42,7 +42,7 @@ fn same_sequence_twice_gives_bitwise_equal_states() {
 
 #[test]
 fn reset_to_a_posture_gives_that_posture() {
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     let posture = [1.0, -0.8, 2.0, 0.9];
     sim.step_rl();
     sim.reset(&posture).unwrap();
@@ -62,9 +62,9 @@ fn reset_to_a_posture_gives_that_posture() {
 fn a_plant_can_move_to_a_worker_thread() {
     // Trials run in parallel (rayon): each builds its own plant and owns it.
     fn assert_send<T: Send>() {}
-    assert_send::<PhysicsSim>();
+    assert_send::<World>();
     let handle = std::thread::spawn(|| {
-        let mut sim = common::arms(SimOptions::default());
+        let mut sim = common::arms(WorldConfig::default());
         sim.step_rl();
         sim.joint_positions()
     });

@@ -1,6 +1,6 @@
 //! A free-floating robot on the ground: root DoFs, reset of the base, contacts, fall test.
 use nalgebra::Isometry3;
-use sim::{FallCriteria, PhysicsSim, RootMode, SimOptions, UrdfModel};
+use sim::{FallCriteria, RootMode, UrdfModel, World, WorldConfig};
 
 /// A 0.2 × 0.2 × 0.1 m block (1 kg) with a 0.3 m arm on a hinge about y at its top.
 const ROBOT: &str = r#"<robot name="block">
@@ -19,13 +19,13 @@ const ROBOT: &str = r#"<robot name="block">
   </joint>
 </robot>"#;
 
-fn block() -> PhysicsSim {
-    let options = SimOptions {
+fn block() -> World {
+    let options = WorldConfig {
         root: RootMode::Floating,
-        ground: Some(0.0),
-        ..SimOptions::default()
+        floor: Some(0.0),
+        ..WorldConfig::default()
     };
-    PhysicsSim::new(UrdfModel::parse(ROBOT).unwrap(), options).unwrap()
+    World::new(UrdfModel::parse(ROBOT).unwrap(), options).unwrap()
 }
 
 #[test]

@@ -2,23 +2,28 @@
 //! servo-like PD at its home posture, and the shipped lift demos hold still.
 use std::time::Instant;
 
-use sim::humanoid::{
-    FallCheckConfig, reset_on_ground, run_fall_check, run_fall_check_observed, sim_options, support_margin,
-};
-use sim::{PhysicsSim, SimOptions, UrdfModel};
+mod common;
+
+use common::humanoid_world as sim_options;
+use sim::fall::{reset_on_ground, support_margin};
+use sim::fallcheck::{FallCheckConfig, run_fall_check, run_fall_check_observed};
+use sim::{PhysicsConfig, UrdfModel, World, WorldConfig};
 
 const KHR1HV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/khr1hv.urdf");
 
-/// The humanoid with the physics of `sim::humanoid::sim_options`, or other iterations.
-fn humanoid(options: SimOptions) -> PhysicsSim {
-    PhysicsSim::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
+/// The humanoid with the world of the humanoid lift task (`sim_options`), or other iterations.
+fn humanoid(options: WorldConfig) -> World {
+    World::new(UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads"), options).expect("builds")
 }
 
 /// rapier's default solver (4 iterations of 1 PGS pass) with the humanoid's servos.
-fn rapier_default() -> SimOptions {
-    SimOptions {
-        solver_iterations: 4,
-        pgs_iterations: 1,
+fn rapier_default() -> WorldConfig {
+    WorldConfig {
+        physics: PhysicsConfig {
+            solver_iterations: 4,
+            pgs_iterations: 1,
+            ..sim_options().physics
+        },
         ..sim_options()
     }
 }
@@ -54,10 +59,7 @@ fn every_demo_pose_holds_for_two_seconds() {
     for (file, heel) in [("khr1hv_lift_demos.csv", 0.045), ("khr1hv_lift_demos_heel.csv", 0.016)] {
         for (i, pose) in demos(file).iter().enumerate() {
             let mut sim = humanoid(sim_options());
-            let config = FallCheckConfig {
-                hold: 2.0,
-                ..FallCheckConfig::default()
-            };
+            let config = FallCheckConfig::for_task(&common::task("humanoid_lift"), 2.0).unwrap();
             reset_on_ground(&mut sim, pose, "l_foot", 0.0, 0.0).unwrap();
             let kinematic = support_margin(&sim, &config.soles).unwrap();
             let r = &run_fall_check(&mut sim, pose, std::slice::from_ref(pose), &config).unwrap()[0];
@@ -78,15 +80,12 @@ fn every_demo_pose_holds_for_two_seconds() {
 #[test]
 fn stands_for_ten_seconds_at_home_posture() {
     for options in [sim_options(), rapier_default()] {
-        let physics = (options.solver_iterations, options.pgs_iterations);
+        let physics = (options.physics.solver_iterations, options.physics.pgs_iterations);
         let mut sim = humanoid(options.clone());
         let home = vec![0.0; 19];
         reset_on_ground(&mut sim, &home, "l_foot", 0.0, 5e-4).unwrap();
         let start = sim.base_pose().translation;
-        let config = FallCheckConfig {
-            hold: 10.0,
-            ..FallCheckConfig::default()
-        };
+        let config = FallCheckConfig::for_task(&common::task("humanoid_lift"), 10.0).unwrap();
         let report = run_fall_check(&mut sim, &home, std::slice::from_ref(&home), &config).unwrap();
         let end = sim.base_pose().translation;
         let drift = (end.x - start.x).hypot(end.y - start.y);
@@ -113,10 +112,7 @@ fn stands_for_ten_seconds_at_home_posture() {
 #[test]
 fn observed_fall_check_reports_what_the_plain_one_does() {
     let home = vec![0.0; 19];
-    let config = FallCheckConfig {
-        hold: 0.5,
-        ..FallCheckConfig::default()
-    };
+    let config = FallCheckConfig::for_task(&common::task("humanoid_lift"), 0.5).unwrap();
     let plain = run_fall_check(
         &mut humanoid(sim_options()),
         &home,

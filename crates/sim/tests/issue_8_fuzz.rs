@@ -17,13 +17,13 @@ fn humanoid_with(to: &str) -> String {
     xml.replacen(FOREARM, to, 1)
 }
 
-use sim::{PhysicsSim, RootMode, SimError, SimOptions, UrdfModel};
+use sim::{RootMode, SimError, UrdfModel, World, WorldConfig};
 
-fn floating() -> SimOptions {
-    SimOptions {
+fn floating() -> WorldConfig {
+    WorldConfig {
         root: RootMode::Floating,
-        ground: Some(-1.0),
-        ..SimOptions::default()
+        floor: Some(-1.0),
+        ..WorldConfig::default()
     }
 }
 
@@ -68,7 +68,7 @@ fn indefinite_inertia_tensor_is_rejected() {
 #[test]
 fn the_intact_arms_still_step_finitely_with_a_floating_root() {
     let xml = std::fs::read_to_string(common::TWO_ARMS).unwrap();
-    let mut sim = PhysicsSim::new(UrdfModel::parse(&xml).unwrap(), floating()).unwrap();
+    let mut sim = World::new(UrdfModel::parse(&xml).unwrap(), floating()).unwrap();
     sim.set_targets(&[1.55, -1.5, 1.55, 1.5]).unwrap();
     sim.step(8);
     assert!(sim.joint_positions().iter().all(|q| q.is_finite()));
@@ -160,7 +160,7 @@ fn thin_rods_and_rounded_plates_still_load() {
     let plate = FOREARM.replace(r#"izz="3.840e-06""#, r#"izz="3.66e-05""#);
     for to in [rod, plate] {
         let model = UrdfModel::parse(&humanoid_with(&to)).unwrap();
-        let mut sim = PhysicsSim::new(model, floating()).unwrap();
+        let mut sim = World::new(model, floating()).unwrap();
         sim.step(8);
         assert!(sim.joint_positions().iter().all(|q| q.is_finite()), "{to}");
     }

@@ -2,11 +2,11 @@
 mod common;
 
 use nalgebra::{Matrix3, Matrix4, Vector3};
-use sim::{PhysicsSim, PlanarArms, SimOptions, UrdfModel};
+use sim::{PhysicsConfig, PlanarArms, UrdfModel, World, WorldConfig};
 
 #[test]
 fn hands_match_the_analytic_arms_for_random_postures() {
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     let left = sim.frame("left_hand", [0.0; 3]).unwrap();
     let right = sim.frame("right_hand", [0.0; 3]).unwrap();
     let arms = PlanarArms::default();
@@ -95,11 +95,14 @@ fn chain_urdf() -> String {
 #[test]
 fn compound_rpy_chain_matches_independent_fk() {
     let model = UrdfModel::parse(&chain_urdf()).unwrap();
-    let options = SimOptions {
-        gravity: [0.0; 3],
-        ..SimOptions::default()
+    let options = WorldConfig {
+        physics: PhysicsConfig {
+            gravity: [0.0; 3],
+            ..PhysicsConfig::default()
+        },
+        ..WorldConfig::default()
     };
-    let mut sim = PhysicsSim::new(model, options).unwrap();
+    let mut sim = World::new(model, options).unwrap();
     let mut rng = common::Rng(11);
     for _ in 0..50 {
         let q: Vec<f64> = (0..3).map(|_| rng.range(-2.5, 2.5)).collect();

@@ -2,13 +2,13 @@
 //! 0.1 rad step to < 1 mrad within 0.05 s at dt ≤ 1/240).
 mod common;
 
-use sim::{PdGains, SimOptions};
+use sim::{PdGains, PhysicsConfig, ServoConfig, WorldConfig};
 
 const START: [f64; 4] = [0.6, -1.2, 2.5, 1.2];
 
 /// Largest |q − target| after `seconds` of tracking a 0.1 rad step on every joint.
-fn step_error(options: SimOptions, seconds: f64) -> f64 {
-    let dt = options.dt;
+fn step_error(options: WorldConfig, seconds: f64) -> f64 {
+    let dt = options.physics.dt;
     let mut sim = common::arms(options);
     sim.reset(&START).unwrap();
     let target: Vec<f64> = START.iter().map(|q| q + 0.1).collect();
@@ -25,10 +25,13 @@ fn step_error(options: SimOptions, seconds: f64) -> f64 {
 fn step_of_a_tenth_radian_settles_below_one_milliradian_in_50_ms() {
     // (dt, solver iterations): the default, a finer step, and the cheaper 2 iterations.
     for (dt, iterations) in [(1.0 / 240.0, 4), (1.0 / 500.0, 4), (1.0 / 240.0, 2)] {
-        let options = SimOptions {
-            dt,
-            solver_iterations: iterations,
-            ..SimOptions::default()
+        let options = WorldConfig {
+            physics: PhysicsConfig {
+                dt,
+                solver_iterations: iterations,
+                ..PhysicsConfig::default()
+            },
+            ..WorldConfig::default()
         };
         let err = step_error(options, 0.05);
         println!(
@@ -41,7 +44,7 @@ fn step_of_a_tenth_radian_settles_below_one_milliradian_in_50_ms() {
 
 #[test]
 fn one_rl_step_is_fifty_milliseconds_and_tracks() {
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     assert!((sim.rl_dt() - 0.05).abs() < 1e-12);
     sim.reset(&START).unwrap();
     let target = [0.7, -1.1, 2.6, 1.3];
@@ -55,7 +58,7 @@ fn one_rl_step_is_fifty_milliseconds_and_tracks() {
 
 #[test]
 fn holding_a_posture_keeps_it() {
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     sim.reset(&START).unwrap();
     sim.step(240);
     for (q, t) in sim.joint_positions().iter().zip(START) {
@@ -66,21 +69,22 @@ fn holding_a_posture_keeps_it() {
 
 #[test]
 fn weak_gains_and_torque_caps_slow_the_servo() {
-    let weak = SimOptions {
-        gains: PdGains {
+    let weak = WorldConfig {
+        servo: ServoConfig {
             kp: 1000.0,
             kd: 30.0,
             max_force: f64::INFINITY,
+            ..ServoConfig::default()
         },
-        ..SimOptions::default()
+        ..WorldConfig::default()
     };
     let err_weak = step_error(weak, 0.05);
-    let capped = SimOptions {
-        gains: PdGains {
+    let capped = WorldConfig {
+        servo: ServoConfig {
             max_force: 1.0,
-            ..PdGains::default()
+            ..ServoConfig::default()
         },
-        ..SimOptions::default()
+        ..WorldConfig::default()
     };
     let err_capped = step_error(capped, 0.05);
     println!("kp 1000 / kd 30: {err_weak:.3e} rad; kp 5000 capped at 1 N·m: {err_capped:.3e} rad");
@@ -90,7 +94,7 @@ fn weak_gains_and_torque_caps_slow_the_servo() {
 
 #[test]
 fn targets_are_clamped_to_the_joint_limits() {
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     sim.set_targets(&[0.0, 5.0, 0.0, -5.0]).unwrap();
     assert_eq!(sim.targets(), [0.0, 0.3, 0.0, -0.3]);
 }
@@ -98,9 +102,12 @@ fn targets_are_clamped_to_the_joint_limits() {
 #[test]
 fn passive_joint_swings_freely_under_in_plane_gravity() {
     // Gravity along −y acts in the arm plane; a passive shoulder lets the arm fall.
-    let options = SimOptions {
-        gravity: [0.0, -9.81, 0.0],
-        ..SimOptions::default()
+    let options = WorldConfig {
+        physics: PhysicsConfig {
+            gravity: [0.0, -9.81, 0.0],
+            ..PhysicsConfig::default()
+        },
+        ..WorldConfig::default()
     };
     let mut sim = common::arms(options);
     sim.reset(&[0.0, 0.0, 0.0, 0.0]).unwrap();
@@ -115,9 +122,12 @@ fn passive_joint_swings_freely_under_in_plane_gravity() {
 fn rapier_trap_zero_gains_with_a_torque_budget_still_lock_the_joint() {
     // rapier 0.36.1: a motor with kp = kd = 0 but an uncapped force still holds its
     // joint in place, which is why `PdGains::passive` caps the force at 0 instead.
-    let options = SimOptions {
-        gravity: [0.0, -9.81, 0.0],
-        ..SimOptions::default()
+    let options = WorldConfig {
+        physics: PhysicsConfig {
+            gravity: [0.0, -9.81, 0.0],
+            ..PhysicsConfig::default()
+        },
+        ..WorldConfig::default()
     };
     let mut sim = common::arms(options);
     sim.reset(&[0.0, 0.0, 0.0, 0.0]).unwrap();
@@ -139,7 +149,7 @@ fn rapier_trap_zero_gains_with_a_torque_budget_still_lock_the_joint() {
 fn hands_follow_a_moving_target_within_a_millimetre() {
     // RL-like use: a new target every 0.05 s, each up to 0.05 rad per joint away.
     let arms = sim::PlanarArms::default();
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     let mut rng = common::Rng(5);
     let mut target = START;
     sim.reset(&target).unwrap();

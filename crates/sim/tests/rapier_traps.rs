@@ -33,7 +33,7 @@ fn shoulder_angle(world: &PhysicsWorld, h: rapier3d::prelude::MultibodyJointHand
 
 #[test]
 fn detect_collisions_before_the_first_step_freezes_the_robot() {
-    // Workaround: `PhysicsSim` never calls `detect_collisions`; contact queries are
+    // Workaround: `World` never calls `detect_collisions`; contact queries are
     // exact shape distances at the current poses (obstacles.rs).
     let (mut world, h) = arms_world();
     for _ in 0..60 {

@@ -2,7 +2,7 @@
 mod common;
 
 use latent_core::CoreError;
-use sim::{JointKind, PhysicsSim, SimError, SimOptions, UrdfModel};
+use sim::{JointKind, PhysicsConfig, SimError, UrdfModel, World, WorldConfig};
 
 fn robot(body: &str) -> String {
     format!(
@@ -39,7 +39,7 @@ fn arms_file_has_four_hinges_in_urdf_order() {
 
 #[test]
 fn arms_plant_reports_hand_frames_that_have_no_body() {
-    let sim = common::arms(SimOptions::default());
+    let sim = common::arms(WorldConfig::default());
     assert_eq!(sim.num_joints(), 4);
     assert!(sim.frame("left_hand", [0.0; 3]).is_ok());
     assert!(matches!(
@@ -52,7 +52,7 @@ fn arms_plant_reports_hand_frames_that_have_no_body() {
 fn minimal_string_robot_loads() {
     let model = UrdfModel::parse(&robot(HINGE)).unwrap();
     assert_eq!(model.joint_names(), ["j"]);
-    let sim = PhysicsSim::new(model, SimOptions::default()).unwrap();
+    let sim = World::new(model, WorldConfig::default()).unwrap();
     assert_eq!(sim.joint_positions(), [0.0]);
 }
 
@@ -114,7 +114,7 @@ fn mesh_collision_is_unsupported_geometry() {
 
 #[test]
 fn unknown_joint_name_lists_the_known_ones() {
-    let mut sim = common::arms(SimOptions::default());
+    let mut sim = common::arms(WorldConfig::default());
     let err = sim.set_target("left_wrist", 0.1).unwrap_err();
     assert!(
         matches!(&err, SimError::UnknownJoint { known, .. } if known.contains("left_elbow")),
@@ -124,15 +124,16 @@ fn unknown_joint_name_lists_the_known_ones() {
 
 #[test]
 fn bad_options_and_inputs_are_rejected() {
-    let bad = SimOptions {
-        dt: 0.0,
-        ..SimOptions::default()
+    let bad = WorldConfig {
+        physics: PhysicsConfig {
+            dt: 0.0,
+            ..PhysicsConfig::default()
+        },
+        ..WorldConfig::default()
     };
-    assert!(matches!(
-        PhysicsSim::new(common::arms_model(), bad),
-        Err(SimError::Input(CoreError::InvalidParameter { name: "dt", .. }))
-    ));
-    let mut sim = common::arms(SimOptions::default());
+    let err = World::new(common::arms_model(), bad).err().expect("dt = 0 is refused");
+    assert_eq!(err.to_string(), "physics.dt must lie in (0, 0.05], got 0");
+    let mut sim = common::arms(WorldConfig::default());
     assert!(matches!(
         sim.set_targets(&[0.0; 3]),
         Err(SimError::Input(CoreError::Shape { .. }))

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -13,66 +14,66 @@ from matplotlib.patches import Rectangle
 from numpy.typing import NDArray
 
 from latentrl.datasets import arms_forward, grip_error
-from latentrl.experiments.exp2 import (
-    GRIP_TEST_TOLERANCE,
-    TARGET,
-    WALLS,
-    Exp2Preset,
-    Fitted,
-    fit,
-    in_walls,
-)
+from latentrl.experiments.exp2 import GRIP_TEST_TOLERANCE, Exp2Preset, Fitted, fit, task_of
 from latentrl.experiments.latent_runs import recorded_episodes
 from latentrl.experiments.presets import latent_box
 from latentrl.pca import PCA
-from latentrl.plots import (
-    hand_paths,
-    latent_run_figures,
-    latent_value_panel,
-    save_figure,
-    shown_paths,
-)
+from latentrl.plots import hand_paths, latent_run_figures, latent_value_panel, save_figure, shown_paths
+from latentrl.task import Task
+
+PLANAR_HANDS = [0, 1, 3, 4]
+"""Columns (x_L, y_L, x_R, y_R) of a recorded row of the planar arms (effectors x, y, z each)."""
 
 
 def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
     """Fig. 5, 6a, 6b, 6c, 6d into `out` (PNG + PDF)."""
     fitted = fit(preset)
+    task = task_of(preset)
+    config = task.to_dict()
     _fig5(preset, fitted, out)
     latent_run_figures(
         preset, arrays, out, names=("fig6a", "fig6b", "fig6d"), title="Exp 2: two planar arms, mean ± s.d. over trials",
-        panel=lambda ax, w: _latent_panel(ax, fitted, w),
+        learner=config["learner"], panel=lambda ax, w: _latent_panel(ax, task, fitted, w, config["learner"]),
     )
     fig, ax = plt.subplots(figsize=(6, 4.5))
-    _walls(ax)
+    _walls(ax, config)
     paths, label, key = shown_paths(arrays)
+    target = np.asarray(config["target"]["position"])[:, :2].ravel()
     if paths is not None:
         episodes = recorded_episodes(preset.episodes) if key == "latent" else []
-        hand_paths(ax, paths[0], target=TARGET, labels=[f"episode {e + 1}" for e in episodes])
+        hand_paths(ax, paths[0][..., PLANAR_HANDS], target=target, labels=[f"episode {e + 1}" for e in episodes])
     ax.set_title(f"hand paths, {label} (trial 1); dashed: right hand")
     ax.set_xlim(-0.65, 0.6)
     ax.set_ylim(-0.05, 0.65)
     save_figure(fig, out, "fig6c")
 
 
-def _walls(ax: Axes) -> None:
-    for x0, y0, x1, y1 in WALLS:
+def _walls(ax: Axes, config: Mapping[str, Any]) -> None:
+    """The task's effector-tested boxes in the arm plane."""
+    for wall in config["obstacles"]:
+        (x0, y0, _), (x1, y1, _) = wall["min"], wall["max"]
         ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, color="k"))
 
 
-def _latent_panel(ax: Axes, fitted: Fitted, weights: NDArray[np.float64], grid: int = 120) -> None:
-    """`plots.latent_value_panel` with the corridor mapped into latent space (black: decoded
-    hands in a wall), grip broken > 5 mm (red line) and the target region (dashed white)."""
+def _latent_panel(
+    ax: Axes, task: Task, fitted: Fitted, weights: NDArray[np.float64], learner: Mapping[str, Any], grid: int = 120
+) -> None:
+    """`plots.latent_value_panel` with the task's rules mapped into latent space by the native
+    plant: black where the decoded hands are in a wall, red lines around the postures that break
+    the grip, dashed white around the target region."""
+    plant = task.plant(fitted.demos)
+    reach = task.to_dict()["target"]["reach_radius"]
 
     def regions(ax: Axes, g0: NDArray[np.float64], g1: NDArray[np.float64], postures: NDArray[np.float64]) -> None:
-        hands = arms_forward(postures)
-        walls = in_walls(hands).reshape(g0.shape)
-        ax.contourf(g0, g1, walls.astype(float), levels=[0.5, 1.5], colors="k")
-        drop = grip_error(hands, test="vector").reshape(g0.shape)
-        ax.contour(g0, g1, drop, levels=[GRIP_TEST_TOLERANCE], colors="r", linewidths=1)
-        rms = np.sqrt(((hands - TARGET) ** 2).sum(axis=1) / 2).reshape(g0.shape)
-        ax.contour(g0, g1, rms, levels=[0.05], colors="w", linestyles="--", linewidths=1)
+        codes, effectors = plant.classify(np.clip(postures, task.lower, task.upper))
+        codes = codes.reshape(g0.shape)
+        ax.contourf(g0, g1, (codes == 1).astype(float), levels=[0.5, 1.5], colors="k")
+        ax.contour(g0, g1, (codes == 3).astype(float), levels=[0.5], colors="r", linewidths=1)
+        target = np.asarray(task.to_dict()["target"]["position"]).ravel()
+        rms = np.sqrt(((effectors - target) ** 2).sum(axis=1) / 2).reshape(g0.shape)
+        ax.contour(g0, g1, rms, levels=[reach], colors="w", linestyles="--", linewidths=1)
 
-    latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, regions=regions, grid=grid)
+    latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, learner=learner, regions=regions, grid=grid)
 
 
 def _fig5(preset: Exp2Preset, fitted: Fitted, out: Path) -> None:

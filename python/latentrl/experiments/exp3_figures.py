@@ -13,29 +13,32 @@ from matplotlib.axes import Axes
 from matplotlib.patches import Rectangle
 from numpy.typing import NDArray
 
-from latentrl import humanoid
-from latentrl.experiments.exp3 import OBSTACLE, TASK_HEAD, Exp3Preset, Fitted, fit, rest_map, target
+from latentrl.experiments.exp3 import Exp3Preset, Fitted, fit, task_of
 from latentrl.experiments.latent_runs import recorded_episodes
 from latentrl.plots import (
     latent_run_figures,
     latent_value_panel,
+    link_positions,
     save_figure,
     shown_paths,
     side_view_stick,
 )
+from latentrl.task import Task
 
 
 def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
     """Fig. 7b, 7c, 7d, 7e and 8 into `out` (PNG + PDF)."""
     fitted = fit(preset)
+    task = task_of(preset)
+    config = task.to_dict()
     maps: dict[str, Any] = {}
     latent_run_figures(
         preset, arrays, out, names=("fig7e", "fig7b", "fig7c"), title="Exp 3: humanoid lift, mean ± s.d. over trials",
-        panel=lambda ax, w: _latent_panel(ax, preset, fitted, w, maps),
+        learner=config["learner"], panel=lambda ax, w: _latent_panel(ax, preset, task, fitted, w, maps),
     )
     paths, label, returns_key = shown_paths(arrays)
     fig, ax = plt.subplots(figsize=(5, 5))
-    _side_view(ax)
+    _side_view(ax, config)
     if paths is not None:
         for k, path in enumerate(paths[0]):
             path = path[np.isfinite(path).all(axis=1)]
@@ -45,66 +48,58 @@ def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], out: Path) -> 
             ax.plot(path[:, 0], path[:, 2], color=shade, lw=1)
             ax.plot(path[:, 3], path[:, 5], color=shade, lw=1, ls="--")
             ax.plot(path[0, 0], path[0, 2], "o", color=shade, ms=3)
-    h_star = target()
+    h_star = np.asarray(config["target"]["position"]).ravel()
     ax.plot([h_star[0]], [h_star[2]], "r*", ms=10, label="target")
     ax.set(xlim=(-0.05, 0.32), ylim=(-0.01, 0.36), xlabel="x (m, forward)", ylabel="z (m, up)")
     ax.set_aspect("equal")
     ax.set_title(f"hand paths, {label} (trial 1)\nside view; dashed: right hand")
     save_figure(fig, out, "fig7d")
-    _fig8(arrays, paths, returns_key, out)
+    _fig8(arrays, paths, returns_key, out, task, fitted.demos)
 
 
-def _side_view(ax: Axes) -> None:
-    """The floor and the obstacle in the x–z plane."""
-    cx, _, cz, hx, _, hz = OBSTACLE
-    ax.add_patch(Rectangle((cx - hx, cz - hz), 2 * hx, 2 * hz, color="0.5", alpha=0.5))
+def _side_view(ax: Axes, config: Mapping[str, Any], dx: float = 0.0) -> None:
+    """The floor and the task's obstacles in the x–z plane."""
+    for box in config["obstacles"]:
+        (cx, _, cz), (hx, _, hz) = box["center"], box["half_extents"]
+        ax.add_patch(Rectangle((dx + cx - hx, cz - hz), 2 * hx, 2 * hz, color="0.5", alpha=0.5))
     ax.axhline(0.0, color="0.3", lw=1.5)
 
 
 def _latent_panel(
-    ax: Axes, preset: Exp3Preset, fitted: Fitted, weights: NDArray[np.float64], maps: dict[str, Any]
+    ax: Axes, preset: Exp3Preset, task: Task, fitted: Fitted, weights: NDArray[np.float64], maps: dict[str, Any]
 ) -> None:
-    """`plots.latent_value_panel` on a `map_grid` grid with the decoded postures at rest that touch
-    the obstacle (black), fall (grey) or break the grip (red), and the target region (dashed
-    white: RMS per-hand distance to h* ≤ 2 reach radii, standing). `maps` caches `rest_map`
-    between the panels."""
-    h_star = np.array(target())
+    """`plots.latent_value_panel` on a `map_grid` grid with the decoded postures (clipped to the
+    joint limits) that, standing at rest, break a rule of the task (the native plant's
+    `classify`): touch the obstacle (black), fall (grey) or break the grip (red); and the target
+    region (dashed white: RMS per-hand distance to h* ≤ 2 reach radii, standing). `maps` caches
+    the classification between the panels."""
+    config = task.to_dict()
+    h_star = np.asarray(config["target"]["position"]).ravel()
 
     def regions(ax: Axes, g0: NDArray[np.float64], g1: NDArray[np.float64], postures: NDArray[np.float64]) -> None:
         if "rest" not in maps:
-            maps["rest"], maps["hands"] = rest_map(preset, postures)
+            plant = task.plant(fitted.demos)
+            maps["rest"], maps["hands"] = plant.classify(np.clip(postures, task.lower, task.upper))
         rest, hands = maps["rest"].reshape(g0.shape), maps["hands"]
         for code, colour in ((1, "k"), (4, "0.6"), (3, "tab:red")):
             if (rest == code).any():
                 ax.contourf(g0, g1, (rest == code).astype(float), levels=[0.5, 1.5], colors=colour, alpha=0.8)
         rms = np.sqrt(((hands - h_star) ** 2).sum(axis=1) / 2).reshape(g0.shape)
-        ax.contour(g0, g1, rms, levels=[2 * preset.reach_radius], colors="w", linestyles="--", linewidths=1)
+        reach = config["target"]["reach_radius"]
+        ax.contour(g0, g1, rms, levels=[2 * reach], colors="w", linestyles="--", linewidths=1)
 
-    latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, regions=regions, grid=preset.map_grid)
+    latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, learner=config["learner"], regions=regions,
+                       grid=preset.map_grid)
     for i, (z0, z1) in enumerate(fitted.model.Z_):
         ax.annotate(str(i), (z0, z1), color="w", fontsize=7, xytext=(3, 3), textcoords="offset points")
 
 
-def _base(row: NDArray[np.float64]) -> NDArray[np.float64]:
-    """4×4 base pose from a trajectory row (position at 6:9, quaternion x, y, z, w at 9:13)."""
-    x, y, z, w = row[9:13]
-    rotation = np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
-    base = np.eye(4)
-    base[:3, :3] = rotation
-    base[:3, 3] = row[6:9]
-    return base
-
-
 def _fig8(arrays: Mapping[str, np.ndarray], paths: np.ndarray | None, returns_key: str, out: Path,
-          frames: int = 6) -> None:
+          task: Task, demos: NDArray[np.float64], frames: int = 6) -> None:
     """Frames of a learnt lift: of trial 1's recorded episodes that reached h* (all, if none
     did), the one whose hands rose most; frames from its start to where the hands are 95 % of
     the way up, and its last step. Side view, drawn from the recorded base poses and joint
-    angles with the NumPy kinematics (`Humanoid.link_poses`)."""
+    angles by the native kinematics (`TaskPlant.pose_links`)."""
     fig, ax = plt.subplots(figsize=(10, 3))
     if paths is not None and paths.shape[1] > 0:
         returns = np.asarray(arrays[returns_key])[0]
@@ -122,13 +117,13 @@ def _fig8(arrays: Mapping[str, np.ndarray], paths: np.ndarray | None, returns_ke
         z = heights[best]
         top = int(np.argmax(z >= z[0] + 0.95 * rise[best]))
         picks = np.unique(np.r_[np.linspace(0, top, frames - 1).round().astype(int), len(path) - 1])
-        h = humanoid.model()
+        plant, rows, config = task.plant(demos), task.row_slices(), task.to_dict()
+        base = np.r_[rows["base_position"], rows["base_quaternion"]]
         for k, step in enumerate(picks):
             dx = 0.35 * k
-            poses = h.link_poses(path[step, TASK_HEAD:], _base(path[step]))
-            cx, _, cz, hx, _, hz = OBSTACLE
-            ax.add_patch(Rectangle((dx + cx - hx, cz - hz), 2 * hx, 2 * hz, color="0.5", alpha=0.4))
-            side_view_stick(ax, h.edges, poses, "C0", dx)
+            poses = plant.pose_links(path[step, base], path[step, rows["joints"]])
+            _side_view(ax, config, dx)
+            side_view_stick(ax, task.edges, link_positions(task.link_names, poses), "C0", dx)
             ax.text(dx + 0.05, 0.33, f"step {step}", fontsize=8, ha="center")
         ax.set_title(f"a learnt lift: recorded episode {int(recorded[best])} of trial 1 (return "
                      f"{returns[recorded[best]]:.1f}, hands {1e3 * rise[best]:.0f} mm up)")

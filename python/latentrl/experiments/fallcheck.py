@@ -10,26 +10,30 @@ For each method — PCA, GPLVM, and plain joint interpolation (the control) — 
    each held `path_hold` s, starting from the decoded first pose.
 
 Each row reports the rms and largest joint error (deg; paths: against joint interpolation
-at the same fraction), the kinematic grip error and support margin of the decoded pose(s)
-(NumPy FK, statically placed), and the simulated smallest support margin, largest
-|grip error| and whether it fell (Rust, rapier). PCA falls are reported as observed: the
-effect depends on how close to the heel the demos balance (docs/humanoid.md).
+at the same fraction), the grip error and support margin of the decoded pose(s) standing at
+rest (the task's plant), and the simulated smallest support margin, largest |grip error| and
+whether it fell (the Rust fall check). PCA falls are reported as observed: the effect depends
+on how close to the heel the demos balance (docs/humanoid.md). The robot, its servos, physics,
+soles and grip are those of the humanoid lift task (`tasks/humanoid_lift.toml`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from latentrl import _native
 from latentrl.demos import load_demos
+from latentrl.experiments.exp3 import demos_path
 from latentrl.gplvm import GPLVM
-from latentrl.humanoid import demos_path, fall_check, model
 from latentrl.pca import PCA
+from latentrl.task import Task
 
 #: Style of each row of the shipped demo files: 4 straight-arm hip-hinge + 3 knee-squat poses.
 STYLES = (0, 0, 0, 0, 1, 1, 1)
@@ -54,6 +58,37 @@ class FallCheckPreset:
     """Seed of the GPLVM fit."""
 
 
+@cache
+def humanoid() -> Task:
+    """The humanoid lift task: the robot, servos, physics, soles and grip of the check."""
+    return Task.shipped("humanoid_lift")
+
+
+class FallCheck(NamedTuple):
+    """What `fall_check` saw."""
+
+    segments: NDArray[np.float64]
+    """(M, 7), one row per target: fell, min support margin, final support margin, grip
+    error at the end, max |grip error| (m), final base height (m), time of the fall (s since
+    the start; NaN while standing)."""
+    frames: NDArray[np.float64]
+    """(K, 9 + D), one per reached `record_times` entry, taken at the first check at or
+    after it: time (s), fell, base position (3), base quaternion (x, y, z, w), joints (D)."""
+
+
+def fall_check(
+    start: NDArray[np.float64], targets: NDArray[np.float64], *, hold: float = 1.0, record_times: Sequence[float] = ()
+) -> FallCheck:
+    """Physics fall check (Rust `sim::fallcheck`) in the humanoid lift task's world: stand at
+    `start`, hold each row of `targets` for `hold` s, checking every 4 physics steps; records the
+    robot at `record_times` (s) for pictures."""
+    start = np.ascontiguousarray(start, dtype=np.float64)
+    targets = np.ascontiguousarray(np.atleast_2d(targets), dtype=np.float64)
+    times = [float(t) for t in record_times]
+    table, frames = _native.fall_check(humanoid()._native, start, targets, hold=hold, record_times=times)
+    return FallCheck(table, frames)
+
+
 def _rms_max(a: NDArray[np.float64], b: NDArray[np.float64]) -> tuple[float, float]:
     d = np.degrees(a - b)
     return float(np.sqrt(np.mean(d**2))), float(np.abs(d).max())
@@ -67,7 +102,7 @@ def fit_coders(preset: FallCheckPreset | None = None) -> tuple[NDArray[np.float6
     """The demo postures X (N, D) and, per method of `METHODS`, the demos' latent points and a
     decoder of latent points (M, d) to postures (M, D) clipped to the joint limits."""
     p = preset or FallCheckPreset()
-    h = model()
+    h = humanoid()
     demos = load_demos(
         Path(p.demos) if p.demos else demos_path(heel=True), expected_joints=h.joint_names
     )
@@ -122,12 +157,13 @@ def run_fallcheck(preset: FallCheckPreset | None = None) -> list[dict[str, Any]]
     """Runs the check; one dict per (method, pose or line) with the keys of `COLUMNS`."""
     p = preset or FallCheckPreset()
     X, coders = fit_coders(p)
+    plant = humanoid().plant(X)
     rows: list[dict[str, Any]] = []
     for method in METHODS:
         for segment in segments(p):
             targets, control, hold = segment_targets(X, coders[method], segment, p)
             sim = fall_check(targets[0], targets, hold=hold).segments
-            rows.append(_row(method, segment, targets, control, sim, model()))
+            rows.append(_row(method, segment, targets, control, sim, plant))
     return rows
 
 
@@ -138,18 +174,23 @@ COLUMNS = (
 )
 
 
+def at_rest(plant: _native.TaskPlant, posture: NDArray[np.float64]) -> tuple[float, float]:
+    """Grip error (m, hand distance − width) and support margin (m) of `posture` standing at rest."""
+    plant.reset(posture)
+    return float(plant.constraint_errors()[0]), float(plant.support_margin())
+
+
 def _row(method: str, segment: str, poses: NDArray[np.float64], reference: NDArray[np.float64],
-         sim: NDArray[np.float64], h: Any) -> dict[str, Any]:
-    balance = [h.balance(q) for q in poses]
+         sim: NDArray[np.float64], plant: _native.TaskPlant) -> dict[str, Any]:
+    grips, margins = zip(*(at_rest(plant, q) for q in poses))
     rms, worst = _rms_max(poses, reference)
-    grips = [b["grip_error"] for b in balance]
     return {
         "method": method,
         "segment": segment,
         "rms_deg": rms,
         "max_deg": worst,
         "grip_error": float(grips[int(np.argmax(np.abs(grips)))]),
-        "margin": float(min(b["margin"] for b in balance)),
+        "margin": float(min(margins)),
         "sim_margin": float(sim[:, 1].min()),
         "sim_grip_error": float(sim[:, 4].max()),
         "fell": bool(sim[:, 0].max() > 0.5),

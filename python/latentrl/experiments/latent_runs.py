@@ -1,17 +1,19 @@
 """What the latent-space experiments' setups share: which episodes keep their paths, the fitted
-GPLVM's metadata for the results, and a Rust trial runner bound to one robot and latent box."""
+GPLVM's metadata for the results, and the native trial runner bound to a task, a GPLVM and its
+latent box."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from functools import partial
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl.experiments.runner import RunTrials
+from latentrl import _native
+from latentrl.experiments.runner import RunTrials, Setup
 from latentrl.gplvm import GPLVM
+from latentrl.task import Task
 
 
 def recorded_episodes(episodes: int) -> list[int]:
@@ -38,30 +40,56 @@ def gplvm_info(model: GPLVM) -> dict[str, Any]:
     }
 
 
-def robot_learner(
-    run_trials: Callable[..., Any],
-    urdf: str,
-    preset: Any,
+def task_learner(
+    task: Task,
     model: GPLVM,
     box: tuple[NDArray[np.float64], NDArray[np.float64]],
-    config: dict[str, Any],
+    demos: NDArray[np.float64],
+    *,
+    episodes: int,
+    seed: int,
+    test_episodes: int = 0,
 ) -> RunTrials:
-    """`run_trials` (`_native.run_arms_trials` or `run_lift_trials`) on the robot at `urdf`,
-    decoding and encoding with `model` in the latent `box` (low, high), with the preset's
-    episodes, seed and frozen test episodes, the recorded episodes and the final weights."""
+    """`_native.run_task_trials` on `task`, decoding and encoding with `model` in the latent
+    `box` (low, high), starting "demo" episodes from `demos`, with the recorded episodes and the
+    final weights."""
     low, high = box
     return partial(
-        run_trials,
-        urdf,
+        _native.run_task_trials,
+        task._native,
         decoder=model.decoder_,
         encoder=model.encoder_,
         latent_low=low,
         latent_high=high,
-        episodes=preset.episodes,
-        base_seed=preset.seed,
-        config=config,
-        record_episodes=recorded_episodes(preset.episodes),
-        test_episodes=preset.test_episodes,
-        record_test_episodes=recorded_tests(preset.test_episodes),
+        demos=np.ascontiguousarray(demos, dtype=np.float64),
+        episodes=episodes,
+        base_seed=seed,
+        record_episodes=recorded_episodes(episodes),
+        test_episodes=test_episodes,
+        record_test_episodes=recorded_tests(test_episodes),
         return_weights=True,
     )
+
+
+def latent_setup(
+    preset: Any,
+    task: Task,
+    model: GPLVM,
+    box: tuple[NDArray[np.float64], NDArray[np.float64]],
+    demos: NDArray[np.float64],
+) -> Setup:
+    """The setup of a latent experiment on a task: its one learner and what results.json
+    records of the fit, the box, the recorded episodes and the effective task."""
+    low, high = box
+    learner = task_learner(
+        task, model, box, demos, episodes=preset.episodes, seed=preset.seed, test_episodes=preset.test_episodes
+    )
+    info = {
+        "gplvm": gplvm_info(model),
+        "latent_box": {"low": low, "high": high},
+        "demo_latent": model.Z_,
+        "recorded_episodes": recorded_episodes(preset.episodes),
+        "recorded_test_episodes": recorded_tests(preset.test_episodes),
+        "task": task.to_dict(),
+    }
+    return Setup(learners={"latent": learner}, info=info)

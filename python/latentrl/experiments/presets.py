@@ -1,4 +1,12 @@
-"""Helpers shared by the experiment presets (frozen dataclasses, one docstring per field)."""
+"""What the RL experiments' presets are made of: the shared part (`LatentRun`: trials, GPLVM
+fit, overrides of the experiment's task) that each experiment's frozen dataclass extends, the
+field docs the CLI shows, and how overrides (a CLI flag, a sweep cell, a keyword) apply.
+
+A preset field is a Python-side choice (how many trials, how the GPLVM is fitted, what the
+figures draw); every task, learner and physics parameter is a key of the experiment's task
+file, overridden by key path (``task={"learner.alpha": 0.5}``, ``--learner.alpha 0.5``) and
+checked by the native side's rules.
+"""
 
 from __future__ import annotations
 
@@ -6,6 +14,8 @@ import ast
 import dataclasses
 import inspect
 import textwrap
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from functools import cache
 from typing import Any
 
@@ -16,19 +26,23 @@ from latentrl._validation import int_at_least
 
 @cache
 def field_docs(preset_cls: type) -> dict[str, str]:
-    """The attribute docstrings of a dataclass (the string literal under each field)."""
-    tree = ast.parse(textwrap.dedent(inspect.getsource(preset_cls)))
-    body = tree.body[0].body  # type: ignore[attr-defined]
-    docs = {}
-    for field, doc in zip(body, body[1:]):
-        if (
-            isinstance(field, ast.AnnAssign)
-            and isinstance(field.target, ast.Name)
-            and isinstance(doc, ast.Expr)
-            and isinstance(doc.value, ast.Constant)
-            and isinstance(doc.value.value, str)
-        ):
-            docs[field.target.id] = " ".join(doc.value.value.split())
+    """The attribute docstrings of a dataclass and its dataclass bases (the string literal under
+    each field; a subclass's own wins)."""
+    docs: dict[str, str] = {}
+    for cls in reversed(preset_cls.__mro__):
+        if not dataclasses.is_dataclass(cls):
+            continue
+        tree = ast.parse(textwrap.dedent(inspect.getsource(cls)))
+        body = tree.body[0].body  # type: ignore[attr-defined]
+        for item, doc in zip(body, body[1:]):
+            if (
+                isinstance(item, ast.AnnAssign)
+                and isinstance(item.target, ast.Name)
+                and isinstance(doc, ast.Expr)
+                and isinstance(doc.value, ast.Constant)
+                and isinstance(doc.value.value, str)
+            ):
+                docs[item.target.id] = " ".join(doc.value.value.split())
     return docs
 
 
@@ -58,3 +72,62 @@ def check_floats(preset: Any, names: tuple[str, ...], *, positive: bool) -> None
         if not ok or value < 0 or (positive and value == 0):
             bound = "> 0" if positive else ">= 0"
             raise ValueError(f"{name} must be a finite number {bound}, got {value!r}")
+
+
+class Overrides(dict[str, Any]):
+    """Task keys by path → values: a dict that hashes by its items, so that presets holding one
+    stay hashable (caches, sweep cells)."""
+
+    def __hash__(self) -> int:  # type: ignore[override]
+        return hash(repr(sorted(self.items(), key=lambda kv: kv[0])))
+
+
+@dataclass(frozen=True)
+class LatentRun:
+    """What every latent-space RL experiment's preset holds: the trials, the GPLVM fit, and
+    overrides of the experiment's task by key path."""
+
+    trials: int = 4
+    """Independent RL trials."""
+    episodes: int = 1000
+    """Training episodes per trial."""
+    seed: int = 0
+    """Base seed: demonstrations, GPLVM fit and every trial's RNG derive from it."""
+    test_episodes: int = 0
+    """Frozen test episodes per trial after training (no TD updates, the task's test starts); 0 = none."""
+    gplvm_max_iter: int = 1000
+    """L-BFGS iteration cap of the GPLVM fit."""
+    latent_margin: float = 0.1
+    """Latent box = bounding box of the fitted latent points, widened by this share per side (ours: 10 %)."""
+    task: Mapping[str, Any] = field(default_factory=dict)
+    """Overrides of the experiment's task by key path, e.g. {"learner.alpha": 0.5} (flags: --learner.alpha)."""
+
+    def __post_init__(self) -> None:
+        if isinstance(self.task, Mapping) and not isinstance(self.task, Overrides):
+            object.__setattr__(self, "task", Overrides(self.task))
+
+    def check_run(self) -> None:
+        """ValueError naming the first impossible shared field."""
+        check_ints(self, ("trials", "episodes", "gplvm_max_iter"))
+        check_ints(self, ("seed", "test_episodes"), minimum=0)
+        check_floats(self, ("latent_margin",), positive=False)
+        if not isinstance(self.task, Mapping) or not all(isinstance(k, str) and "." in k for k in self.task):
+            raise ValueError(f"task: expected overrides by key path such as {{'learner.alpha': 0.5}}, got {self.task!r}")
+
+
+def with_overrides(preset: Any, overrides: Mapping[str, Any]) -> Any:
+    """`preset` with `overrides` applied: a preset field by its name, a task key by its path
+    (``learner.alpha``: added to the preset's `task`). An unknown field is a ValueError listing
+    the valid ones; task keys are checked by the task (`validate`)."""
+    fields = {f.name for f in dataclasses.fields(preset)}
+    plain = {k: v for k, v in overrides.items() if "." not in k}
+    unknown = sorted(set(plain) - fields - {"task"})
+    if unknown:
+        raise ValueError(
+            f"unknown preset fields {unknown}; {type(preset).__name__} has {sorted(fields - {'task'})}, "
+            "and task keys are given by path (learner.alpha, episode.max_steps, …)"
+        )
+    task = {**getattr(preset, "task", {}), **plain.pop("task", {}), **{k: v for k, v in overrides.items() if "." in k}}
+    if task and "task" not in fields:
+        raise ValueError(f"{type(preset).__name__} takes no task keys, got {sorted(task)}")
+    return dataclasses.replace(preset, **plain, **({"task": task} if "task" in fields else {}))

@@ -28,7 +28,7 @@ import numpy as np
 from latentrl.experiments.results import worker_threads
 from latentrl.experiments.runner import PER_EPISODE, PER_TRIAL, Setup, load_arrays, run_rl
 from latentrl.experiments.registry import rl_experiments
-from latentrl.experiments.sweep import Job, check_type
+from latentrl.experiments.sweep_types import Job, check_type
 
 
 def setup_fingerprint(built: Setup) -> str:

@@ -19,6 +19,7 @@ import numpy as np
 from tqdm import tqdm
 
 from latentrl._base import read_npz
+from latentrl.task import end_reasons
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
     environment,
@@ -30,8 +31,8 @@ from latentrl.experiments.results import (
     write_npz,
 )
 
-END_CODES = {0: "timeout", 1: "obstacle", 2: "box_exit", 3: "drop", 4: "fall", 5: "variance_gate"}
-"""How an episode ended, as stored in `<learner>_end` (−1: not run)."""
+END_CODES = dict(enumerate(end_reasons()))
+"""How an episode ended, as stored in `<learner>_end` (−1: not run): the native names."""
 
 PER_EPISODE = {
     "returns": "",

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 from latentrl.experiments.results import write_json
 from latentrl.experiments.runner import load_arrays
 from latentrl.experiments.registry import rl_experiments
-from latentrl.experiments.sweep import Cell, Sweep
+from latentrl.experiments.sweep_types import Cell, Sweep
 from latentrl.plots import running_mean, save_figure
 
 FINAL_SHARE = 0.1

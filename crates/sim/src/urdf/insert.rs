@@ -3,14 +3,15 @@
 
 use std::path::Path;
 
-use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
+use nalgebra::Isometry3;
 use rapier3d::prelude::{
-    ColliderHandle, JointAxis, MultibodyJointHandle, PhysicsWorld, Pose, RigidBodyBuilder, RigidBodyHandle,
+    ColliderHandle, JointAxis, MultibodyJointHandle, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle,
 };
 use rapier3d_urdf::{UrdfLoaderOptions, UrdfMultibodyOptions, UrdfRobot, urdf_rs};
 
 use super::{JointKind, RootMode, UrdfModel};
 use crate::error::{Result, SimError};
+use crate::pose::origin_pose;
 
 /// Where one actuated joint lives inside the rapier multibody.
 #[derive(Debug, Clone, Copy)]
@@ -36,27 +37,6 @@ pub(crate) struct InsertedRobot {
     pub colliders: Vec<(usize, ColliderHandle)>,
     /// The root link's rigid body.
     pub root: RigidBodyHandle,
-}
-
-/// A URDF `<origin>` as an f64 pose: R = Rz(yaw)·Ry(pitch)·Rx(roll) (URDF convention).
-pub(crate) fn origin_pose(o: &urdf_rs::Pose) -> Isometry3<f64> {
-    let [x, y, z] = o.xyz.0;
-    let [roll, pitch, yaw] = o.rpy.0;
-    Isometry3::from_parts(
-        Translation3::new(x, y, z),
-        UnitQuaternion::from_euler_angles(roll, pitch, yaw),
-    )
-}
-
-/// A rapier (glam, f32) pose widened to an f64 nalgebra isometry.
-pub(crate) fn to_isometry(p: &Pose) -> Isometry3<f64> {
-    let t = p.translation;
-    let q = p.rotation;
-    let quat = Quaternion::new(q.w as f64, q.x as f64, q.y as f64, q.z as f64);
-    Isometry3::from_parts(
-        Translation3::new(t.x as f64, t.y as f64, t.z as f64),
-        UnitQuaternion::from_quaternion(quat),
-    )
 }
 
 impl UrdfModel {

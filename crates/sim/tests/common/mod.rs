@@ -4,10 +4,36 @@
 use latent_core::{GpMap, SeKernel};
 use nalgebra::DMatrix;
 use sim::bimanual::BimanualLearner;
-use sim::{PhysicsSim, SimOptions, UrdfModel};
+use sim::{Task, UrdfModel, World, WorldConfig};
 
 /// Path of the shipped two-arm URDF (package data of the Python package).
 pub const TWO_ARMS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/two_arms.urdf");
+
+/// Folder of the shipped task files.
+pub const TASKS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/tasks");
+
+/// The shipped task `name` (`two_arms`, `humanoid_lift`).
+pub fn task(name: &str) -> Task {
+    Task::load(format!("{TASKS}/{name}.toml")).expect("shipped task loads")
+}
+
+/// The world of the humanoid lift task (its servos and physics, the floor).
+pub fn humanoid_world() -> WorldConfig {
+    task("humanoid_lift").world_config()
+}
+
+/// The 7 centred humanoid lift demos (rows 0–3 straight-arm hip hinge, 4–6 knee squat).
+pub fn lift_demos() -> Vec<Vec<f64>> {
+    let path = format!(
+        "{}/../../python/latentrl/data/khr1hv_lift_demos.csv",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(path).expect("demo file");
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect()
+}
 
 /// The two-arm model.
 pub fn arms_model() -> UrdfModel {
@@ -15,8 +41,8 @@ pub fn arms_model() -> UrdfModel {
 }
 
 /// The two-arm plant with `options`.
-pub fn arms(options: SimOptions) -> PhysicsSim {
-    PhysicsSim::new(arms_model(), options).expect("two-arm plant builds")
+pub fn arms(options: WorldConfig) -> World {
+    World::new(arms_model(), options).expect("two-arm plant builds")
 }
 
 /// SplitMix64: a tiny deterministic generator for test inputs.

@@ -1,15 +1,17 @@
-//! Binding of `sim::plant`: a URDF robot in a rapier3d world with PD servos ([`PhysicsSim`]),
+//! Binding of `sim::world`: a URDF robot in a rapier3d world with PD servos ([`World`]),
 //! driven from Python one RL step (or `n` physics steps) per call.
 
 use std::path::PathBuf;
 
-use ::sim::humanoid::reset_on_ground;
-use ::sim::{FallCriteria, Obstacle, ObstacleShape, PdGains, PhysicsSim, RootMode, SimOptions, UrdfModel};
+use ::sim::fall::reset_on_ground;
+use ::sim::{
+    FallCriteria, Obstacle, ObstacleShape, PhysicsConfig, RootMode, ServoConfig, UrdfModel, World, WorldConfig,
+};
 use nalgebra::Isometry3;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
-use crate::convert::fixed;
+use crate::convert::{config_from, fixed};
 use crate::errors::{InvalidInputError, guard, sim_to_py};
 
 /// A 1-D array of any length, copied into a `Vec` (the sim checks the length).
@@ -20,32 +22,23 @@ fn vector(array: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
 /// A URDF robot in a rapier3d world, every actuated joint PD-servoed to its target.
 #[pyclass(name = "Sim", module = "latentrl._native")]
 pub struct PySim {
-    inner: PhysicsSim,
+    inner: World,
 }
 
 #[pymethods]
 impl PySim {
     /// Builds the world from `urdf`: a path, or the URDF XML itself (a str starting with `<`).
-    /// `ground` is the height of a floor half-space (normal +z), or None for no floor.
+    /// `root` "fixed" or "floating"; `floor` the height of a floor half-space (normal +z) or
+    /// None; `physics` and `servo` dicts of the task file's `[physics]` and `[servo]` keys.
     #[new]
-    #[pyo3(signature = (
-        urdf, *, root = "fixed", dt = 1.0 / 240.0, substeps = 12, solver_iterations = 4,
-        pgs_iterations = 1, kp = 5000.0, kd = 50.0, max_force = f64::INFINITY, gravity = None, ground = None
-    ))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (urdf, *, root = "fixed", floor = None, physics = None, servo = None))]
     fn new(
         py: Python<'_>,
         urdf: &Bound<'_, PyAny>,
         root: &str,
-        dt: f64,
-        substeps: i64,
-        solver_iterations: i64,
-        pgs_iterations: i64,
-        kp: f64,
-        kd: f64,
-        max_force: f64,
-        gravity: Option<PyReadonlyArray1<'_, f64>>,
-        ground: Option<f64>,
+        floor: Option<f64>,
+        physics: Option<&Bound<'_, PyAny>>,
+        servo: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         guard(|| {
             let root = match root {
@@ -57,25 +50,14 @@ impl PySim {
                     )));
                 }
             };
-            let count = |name: &str, value: i64| {
-                usize::try_from(value)
-                    .ok()
-                    .filter(|&v| v > 0)
-                    .ok_or_else(|| InvalidInputError::new_err(format!("{name}: expected an int > 0, got {value}")))
-            };
-            let mut options = SimOptions {
+            let physics: PhysicsConfig = physics.map_or(Ok(PhysicsConfig::default()), |p| config_from("physics", p))?;
+            let servo: ServoConfig = servo.map_or(Ok(ServoConfig::default()), |s| config_from("servo", s))?;
+            let config = WorldConfig {
                 root,
-                dt,
-                substeps: count("substeps", substeps)?,
-                solver_iterations: count("solver_iterations", solver_iterations)?,
-                pgs_iterations: count("pgs_iterations", pgs_iterations)?,
-                gains: PdGains::new(kp, kd, max_force).map_err(sim_to_py)?,
-                ground,
-                ..SimOptions::default()
+                floor,
+                physics,
+                servo,
             };
-            if let Some(g) = gravity {
-                options.gravity = fixed::<3>("gravity", &g)?;
-            }
             let model = match urdf.extract::<String>() {
                 Ok(text) if text.trim_start().starts_with('<') => UrdfModel::parse(&text),
                 _ => {
@@ -86,7 +68,7 @@ impl PySim {
                 }
             }
             .map_err(sim_to_py)?;
-            let inner = py.detach(|| PhysicsSim::new(model, options)).map_err(sim_to_py)?;
+            let inner = py.detach(|| World::new(model, config)).map_err(sim_to_py)?;
             Ok(Self { inner })
         })
     }
@@ -94,12 +76,7 @@ impl PySim {
     /// Names of the actuated joints, in the order of postures and targets.
     #[getter]
     fn joint_names(&self) -> Vec<String> {
-        self.inner
-            .model()
-            .joint_names()
-            .into_iter()
-            .map(str::to_string)
-            .collect()
+        crate::convert::owned(self.inner.model().joint_names())
     }
 
     /// Duration of one RL step, `dt · substeps` (s).
@@ -121,13 +98,14 @@ impl PySim {
 
     /// Teleports a floating robot to `posture` at rest standing on the floor: the base is
     /// placed so that link `sole` lies flat, its lowest corner `clearance` m above the ground
-    /// (needs `ground`).
+    /// (needs a `floor`).
     #[pyo3(signature = (posture, sole, clearance = 5e-4))]
     fn reset_on_ground(&mut self, posture: PyReadonlyArray1<'_, f64>, sole: &str, clearance: f64) -> PyResult<()> {
         guard(|| {
-            let ground = self.inner.options().ground.ok_or_else(|| {
-                InvalidInputError::new_err("reset_on_ground: this Sim has no floor (pass ground=...)")
-            })?;
+            let ground =
+                self.inner.config().floor.ok_or_else(|| {
+                    InvalidInputError::new_err("reset_on_ground: this Sim has no floor (pass floor=...)")
+                })?;
             reset_on_ground(&mut self.inner, &vector(&posture), sole, ground, clearance).map_err(sim_to_py)
         })
     }
@@ -173,7 +151,7 @@ impl PySim {
     #[pyo3(signature = (n = None))]
     fn step(&mut self, py: Python<'_>, n: Option<i64>) -> PyResult<()> {
         let steps = match n {
-            None => self.inner.options().substeps,
+            None => self.inner.config().physics.substeps,
             Some(n) => usize::try_from(n)
                 .map_err(|_| InvalidInputError::new_err(format!("n: expected an int >= 0 or None, got {n}")))?,
         };

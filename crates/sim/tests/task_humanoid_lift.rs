@@ -1,44 +1,20 @@
-//! The Experiment 3 plant (SPEC §4.3): the humanoid holds a demo pose without falling, a
-//! path into the obstacle ends on a contact, spreading the arms drops the object, starts
-//! are refused where they must be, an episode does not depend on the one before, and whole
-//! trials repeat bitwise on 1 and 2 threads.
+//! The humanoid lift task (`tasks/humanoid_lift.toml`, SPEC §4.3) on the generic task plant:
+//! the humanoid holds a demo pose without falling, a path into the obstacle ends on a contact,
+//! spreading the arms drops the object, starts are refused where they must be, an episode does
+//! not depend on the one before, and whole trials repeat bitwise on 1 and 2 threads.
+mod common;
+
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
-use latent_core::episode::{EndReason, LearnerConfig, Plant, StartMode};
-use latent_core::trials::{TrialOptions, TrialResult};
-use latent_core::{GpMap, SeKernel};
+use latent_core::trials::{LatentSpace, TrialOptions, TrialResult, run_latent_trials};
+use latent_core::{EndReason, GpMap, LearnerConfig, Plant, SeKernel};
 use nalgebra::DMatrix;
-use sim::Latent2d;
-use sim::UrdfModel;
-use sim::latent::run_latent_trials;
-use sim::lift::{LiftConfig, LiftPlant, TASK_HEAD};
-
-const KHR1HV: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../python/latentrl/data/khr1hv.urdf");
-
-fn model() -> UrdfModel {
-    UrdfModel::from_file(KHR1HV).expect("khr1hv.urdf loads")
-}
-
-/// The 7 centred lift demos (rows 0–3 straight-arm hip hinge, 4–6 knee squat).
-fn demos() -> Vec<Vec<f64>> {
-    let path = format!(
-        "{}/../../python/latentrl/data/khr1hv_lift_demos.csv",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let text = std::fs::read_to_string(path).expect("demo file");
-    text.lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect()
-}
-
-fn plant() -> LiftPlant {
-    LiftPlant::new(model(), LiftConfig::default()).expect("lift plant builds")
-}
+use rand::SeedableRng;
+use sim::{Task, TaskPlant};
 
 /// Steps `n` RL steps along the joint-space line `from → to`; returns the outcomes until
 /// the first end.
-fn walk(p: &mut LiftPlant, from: &[f64], to: &[f64], n: usize) -> Vec<(f64, Option<EndReason>)> {
+fn walk(p: &mut TaskPlant, from: &[f64], to: &[f64], n: usize) -> Vec<(f64, Option<EndReason>)> {
     let mut reached = vec![0.0; from.len()];
     let mut out = Vec::new();
     for k in 1..=n {
@@ -55,8 +31,9 @@ fn walk(p: &mut LiftPlant, from: &[f64], to: &[f64], n: usize) -> Vec<(f64, Opti
 
 #[test]
 fn starts_are_refused_in_the_obstacle_and_the_target_is_the_top_demo() {
-    let mut p = plant();
-    let d = demos();
+    let task = std::sync::Arc::new(common::task("humanoid_lift"));
+    let d = common::lift_demos();
+    let mut p = TaskPlant::new(task.clone(), Some(&d)).unwrap();
     let ends: Vec<Option<EndReason>> = d.iter().map(|q| p.reset(q)).collect();
     let obstacle = Some(EndReason::Obstacle);
     assert_eq!(
@@ -65,19 +42,19 @@ fn starts_are_refused_in_the_obstacle_and_the_target_is_the_top_demo() {
         "demos 0-2 touch the box"
     );
     p.reset(&d[6]);
-    let h = p.hands();
-    for (a, b) in h.iter().zip(&p.config().target) {
-        assert!((a - b).abs() < 2e-3, "{h:?} vs the default target");
+    let target: Vec<f64> = task.config().target.position.iter().flatten().copied().collect();
+    for (a, b) in p.effectors().iter().zip(&target) {
+        assert!((a - b).abs() < 1e-6, "{:?} vs the task's target", p.effectors());
     }
-    assert!(p.reached_target() && p.config().grip_error(&h) < 1e-3);
+    assert!(p.reached_target());
     let mut q = d[6].clone();
     q[0] = 10.0;
     assert_eq!(p.reset(&q), Some(EndReason::BoxExit), "outside the joint limits");
     let mut row = vec![0.0; p.task_dim()];
     p.reset(&d[4]);
     p.task_position(&mut row);
-    assert_eq!(row.len(), TASK_HEAD + 19);
-    assert_eq!(&row[TASK_HEAD..], &p.sim().joint_positions()[..]);
+    assert_eq!(row.len(), 6 + 7 + 19);
+    assert_eq!(&row[13..], &p.world().joint_positions()[..]);
     assert!(
         (row[9..13].iter().map(|x| x * x).sum::<f64>() - 1.0).abs() < 1e-6,
         "unit quaternion"
@@ -85,9 +62,27 @@ fn starts_are_refused_in_the_obstacle_and_the_target_is_the_top_demo() {
 }
 
 #[test]
+fn a_demo_start_is_the_start_demo_plus_noise() {
+    let task = std::sync::Arc::new(common::task("humanoid_lift"));
+    let d = common::lift_demos();
+    let mut p = TaskPlant::new(task.clone(), Some(&d)).unwrap();
+    assert_eq!(p.home(), &d[4][..], "episode.start_demo = 4");
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+    let mut q = vec![0.0; 19];
+    p.sample_start(&mut rng, &mut q);
+    assert!(q.iter().zip(&d[4]).all(|(a, b)| (a - b).abs() <= 0.01 + 1e-12));
+    assert!(q.iter().zip(&d[4]).any(|(a, b)| a != b));
+    assert!(
+        TaskPlant::new(task.clone(), Some(&d[..3])).is_err(),
+        "no demo 4 among 3"
+    );
+}
+
+#[test]
 fn a_held_squat_pose_neither_falls_nor_drops() {
-    let mut p = plant();
-    let d = demos();
+    let task = std::sync::Arc::new(common::task("humanoid_lift"));
+    let d = common::lift_demos();
+    let mut p = TaskPlant::new(task.clone(), Some(&d)).unwrap();
     for i in [4, 6] {
         assert_eq!(p.reset(&d[i]), None);
         let out = walk(&mut p, &d[i], &d[i], 40);
@@ -105,8 +100,9 @@ fn a_held_squat_pose_neither_falls_nor_drops() {
 
 #[test]
 fn a_path_into_the_obstacle_ends_on_contact() {
-    let mut p = plant();
-    let d = demos();
+    let task = std::sync::Arc::new(common::task("humanoid_lift"));
+    let d = common::lift_demos();
+    let mut p = TaskPlant::new(task.clone(), Some(&d)).unwrap();
     assert_eq!(p.reset(&d[3]), None);
     let out = walk(&mut p, &d[3], &d[1], 30);
     let (reward, end) = *out.last().unwrap();
@@ -116,11 +112,12 @@ fn a_path_into_the_obstacle_ends_on_contact() {
 
 #[test]
 fn spreading_the_arms_drops_the_object() {
-    let mut p = plant();
-    let d = demos();
+    let task = std::sync::Arc::new(common::task("humanoid_lift"));
+    let d = common::lift_demos();
+    let mut p = TaskPlant::new(task.clone(), Some(&d)).unwrap();
     assert_eq!(p.reset(&d[6]), None);
     let mut open = d[6].clone();
-    for (i, name) in p.sim().model().joint_names().iter().enumerate() {
+    for (i, name) in task.model().joint_names().iter().enumerate() {
         if name.ends_with("shoulder_roll") {
             open[i] = 0.0;
         }
@@ -131,8 +128,9 @@ fn spreading_the_arms_drops_the_object() {
 
 #[test]
 fn an_episode_does_not_depend_on_the_one_before() {
-    let d = demos();
-    let mut p = plant();
+    let task = std::sync::Arc::new(common::task("humanoid_lift"));
+    let d = common::lift_demos();
+    let mut p = TaskPlant::new(task.clone(), Some(&d)).unwrap();
     p.reset(&d[5]);
     let first = walk(&mut p, &d[5], &d[6], 10);
     // Another episode in between, then the first again on the same plant.
@@ -146,7 +144,7 @@ fn an_episode_does_not_depend_on_the_one_before() {
 /// GP maps through the 7 demos on a hand-made latent layout: z0 = style (−1 hinge, 1 squat),
 /// z1 = progress of the lift in [0, 1].
 fn demo_maps() -> (GpMap, GpMap) {
-    let d = demos();
+    let d = common::lift_demos();
     let latent = [
         (-1.0, 0.0),
         (-1.0, 1.0 / 3.0),
@@ -158,22 +156,20 @@ fn demo_maps() -> (GpMap, GpMap) {
     ];
     let z = DMatrix::from_fn(2, 7, |i, j| if i == 0 { latent[j].0 } else { latent[j].1 });
     let x = DMatrix::from_fn(19, 7, |i, j| d[j][i]);
-    let kernel = SeKernel::new([1.0, 1.0, 1e-6]).unwrap();
     (
-        GpMap::new(z.clone(), x.clone(), kernel).unwrap(),
+        GpMap::new(z.clone(), x.clone(), SeKernel::new([1.0, 1.0, 1e-6]).unwrap()).unwrap(),
         GpMap::new(x, z, SeKernel::new([1.0, 0.5, 1e-4]).unwrap()).unwrap(),
     )
 }
 
-fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
+fn run(threads: usize, task: &std::sync::Arc<Task>, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
     let config = LearnerConfig {
-        max_steps: 8,
-        step_fraction: 0.5,
-        beta: 20.0,
-        start: StartMode::UniformInBox,
-        ..LearnerConfig::default()
+        step: 0.5,
+        ..task.config().learner.clone()
     };
-    let latent = Latent2d {
+    let mut rules = task.episode_rules();
+    rules.max_steps = 8;
+    let latent = LatentSpace {
         decoder,
         encoder,
         low: &[-1.2, -0.1],
@@ -188,12 +184,14 @@ fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let done = AtomicUsize::new(0);
+    let demos = common::lift_demos();
     let results = pool
         .install(|| {
             let cancel = AtomicBool::new(false);
             run_latent_trials(
-                |_| LiftPlant::new(model(), LiftConfig::default()),
+                |_| TaskPlant::new(task.clone(), Some(&demos)),
                 &config,
+                rules,
                 &latent,
                 &options,
                 &cancel,
@@ -207,12 +205,13 @@ fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
 
 #[test]
 fn trials_repeat_bitwise_on_one_and_two_threads() {
+    let task = std::sync::Arc::new(common::task("humanoid_lift"));
     let (decoder, encoder) = demo_maps();
-    let one = run(1, &decoder, &encoder);
-    assert_eq!(one, run(2, &decoder, &encoder), "1 vs 2 threads");
+    let one = run(1, &task, &decoder, &encoder);
+    assert_eq!(one, run(2, &task, &decoder, &encoder), "1 vs 2 threads");
     assert_ne!(one[0].episodes, one[1].episodes, "trials draw different starts");
     for r in &one {
         assert!(r.episodes.iter().all(|e| e.ret.is_finite() && e.steps >= 1));
-        assert_eq!(r.trajectories[0].len() % (TASK_HEAD + 19), 0);
+        assert_eq!(r.trajectories[0].len() % task.row_len(), 0);
     }
 }

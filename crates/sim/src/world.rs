@@ -1,12 +1,12 @@
-//! [`PhysicsSim`]: a URDF robot in a rapier3d world, PD-servoed, stepped in RL steps.
+//! [`World`]: a URDF robot in a rapier3d world, PD-servoed, stepped in RL steps.
 //!
-//! One RL step (SPEC §3.1 step 4) is: [`PhysicsSim::set_targets`] (the decoded posture),
-//! [`PhysicsSim::step_rl`] (`substeps` physics steps of `dt`), then read the reached
-//! posture ([`PhysicsSim::joint_positions`]), hand positions
-//! ([`PhysicsSim::frame_position`]) and contacts (`obstacles.rs`).
+//! One RL step (SPEC §3.1 step 4) is: [`World::set_targets`] (the decoded posture),
+//! [`World::step_rl`] (`substeps` physics steps of `dt`), then read the reached posture
+//! ([`World::joint_positions`]), effector positions ([`World::frame_position`]) and
+//! contacts (`obstacles.rs`).
 //!
 //! Postures and targets are indexed in URDF joint order (actuated joints only); names
-//! map to indices with [`PhysicsSim::joint_index`]. rapier computes in f32; every value
+//! map to indices with [`World::joint_index`]. rapier computes in f32; every value
 //! crossing this API is f64.
 
 use latent_core::CoreError;
@@ -14,20 +14,28 @@ use nalgebra::Isometry3;
 use rapier3d::prelude::{ColliderBuilder, ColliderHandle, PhysicsWorld, Real, RigidBodyHandle, SharedShape, Vector};
 
 use crate::error::{Result, SimError, check_finite};
-use crate::obstacles::ObstacleEntry;
 use crate::pd::{PdGains, drive, retarget};
+use crate::pose::to_pose;
+use crate::shapes::Obstacle;
 use crate::urdf::{JointSlot, RootMode, UrdfModel};
 
-mod options;
+mod config;
 mod readout;
-pub use options::SimOptions;
+pub use config::{JointServo, PhysicsConfig, ServoConfig, WorldConfig};
 pub use readout::Frame;
 
+/// An obstacle in the world and its collider.
+#[derive(Debug, Clone)]
+pub(crate) struct ObstacleEntry {
+    pub spec: Obstacle,
+    pub collider: ColliderHandle,
+}
+
 /// A URDF robot in a rapier world with PD servos on every actuated joint.
-pub struct PhysicsSim {
+pub struct World {
     pub(crate) world: PhysicsWorld,
     pub(crate) model: UrdfModel,
-    pub(crate) options: SimOptions,
+    pub(crate) config: WorldConfig,
     pub(crate) slots: Vec<JointSlot>,
     pub(crate) gains: Vec<PdGains>,
     pub(crate) targets: Vec<f64>,
@@ -39,32 +47,36 @@ pub struct PhysicsSim {
     time: f64,
 }
 
-impl PhysicsSim {
+impl World {
     /// Builds the world: every joint at zero (clamped into its limits), servos holding
-    /// that posture, optional ground.
-    pub fn new(model: UrdfModel, options: SimOptions) -> Result<Self> {
-        options.validate()?;
+    /// that posture, optional floor. Fails on a configuration value that breaks its rule or a
+    /// per-joint servo naming no actuated joint.
+    pub fn new(model: UrdfModel, config: WorldConfig) -> Result<Self> {
+        config.validate()?;
+        if let Some(name) = config.servo.joints.keys().find(|n| model.joint_index(n).is_err()) {
+            return Err(SimError::UnknownJoint {
+                name: format!("servo.joints.{name}"),
+                known: model.joint_names().join(", "),
+            });
+        }
+        let physics = &config.physics;
         let mut world = PhysicsWorld::new();
-        let [gx, gy, gz] = options.gravity;
+        let [gx, gy, gz] = physics.gravity;
         world.gravity = Vector::new(gx as Real, gy as Real, gz as Real);
-        world.integration_parameters.dt = options.dt as Real;
-        world.integration_parameters.num_solver_iterations = options.solver_iterations;
-        world.integration_parameters.num_internal_pgs_iterations = options.pgs_iterations;
-        let robot = model.insert(&mut world, options.root, options.self_collisions)?;
-        let ground = options.ground.map(|z| {
+        world.integration_parameters.dt = physics.dt as Real;
+        world.integration_parameters.num_solver_iterations = physics.solver_iterations;
+        world.integration_parameters.num_internal_pgs_iterations = physics.pgs_iterations;
+        let robot = model.insert(&mut world, config.root, physics.self_collisions)?;
+        let ground = config.floor.map(|z| {
             let plane =
                 ColliderBuilder::new(SharedShape::halfspace(Vector::Z)).translation(Vector::new(0.0, 0.0, z as Real));
             world.colliders.insert(plane)
         });
         let mut gains = Vec::with_capacity(model.joints().len());
         for (info, slot) in model.joints().iter().zip(&robot.slots) {
-            let g = match (options.use_urdf_effort, info.effort) {
-                (true, Some(effort)) => options.gains.capped(effort),
-                _ => options.gains,
-            };
-            gains.push(g);
+            gains.push(config.servo.gains(&info.name, info.effort));
             if let Some((mb, _)) = world.multibody_joints.get_mut(slot.handle) {
-                mb.damping_mut()[slot.dof] = info.damping.unwrap_or(options.joint_damping) as Real;
+                mb.damping_mut()[slot.dof] = info.damping.unwrap_or(physics.joint_damping) as Real;
                 mb.frictions_mut()[slot.dof] = info.friction.unwrap_or(0.0) as Real;
             }
         }
@@ -73,7 +85,7 @@ impl PhysicsSim {
         let mut sim = Self {
             world,
             model,
-            options,
+            config,
             slots: robot.slots,
             gains,
             targets: vec![0.0; n],
@@ -89,8 +101,8 @@ impl PhysicsSim {
     }
 
     /// Loads a URDF file ([`UrdfModel::from_file`]) and builds the world.
-    pub fn from_urdf_file(path: impl AsRef<std::path::Path>, options: SimOptions) -> Result<Self> {
-        Self::new(UrdfModel::from_file(path)?, options)
+    pub fn from_urdf_file(path: impl AsRef<std::path::Path>, config: WorldConfig) -> Result<Self> {
+        Self::new(UrdfModel::from_file(path)?, config)
     }
 
     /// The robot description.
@@ -98,9 +110,9 @@ impl PhysicsSim {
         &self.model
     }
 
-    /// The options the world was built with.
-    pub fn options(&self) -> &SimOptions {
-        &self.options
+    /// The configuration the world was built with.
+    pub fn config(&self) -> &WorldConfig {
+        &self.config
     }
 
     /// Number of actuated joints (the length of postures and targets).
@@ -120,7 +132,7 @@ impl PhysicsSim {
 
     /// Duration of one RL step, `dt · substeps` (s).
     pub fn rl_dt(&self) -> f64 {
-        self.options.dt * self.options.substeps as f64
+        self.config.rl_dt()
     }
 
     fn check_posture(&self, what: &'static str, values: &[f64]) -> Result<()> {
@@ -137,16 +149,16 @@ impl PhysicsSim {
 
     /// Teleports the robot to `posture` at rest (fixed root) and aims the servos at it.
     ///
-    /// Multibody joints start at zero; this sets their coordinates, zeroes every
-    /// velocity, runs forward kinematics and moves the bodies (contact queries see the
-    /// new posture at once).
+    /// Multibody joints start at zero; this sets their coordinates (to exactly `q` as f32,
+    /// whatever they were), zeroes every velocity, runs forward kinematics and moves the
+    /// bodies (contact queries see the new posture at once).
     /// Fails on a wrong length, a non-finite value or a value outside the joint limits.
     pub fn reset(&mut self, posture: &[f64]) -> Result<()> {
         let base = self.base_pose();
         self.reset_with_base(posture, &base)
     }
 
-    /// [`PhysicsSim::reset`] that also places a floating root at `base` (ignored when fixed).
+    /// [`World::reset`] that also places a floating root at `base` (ignored when fixed).
     pub fn reset_with_base(&mut self, posture: &[f64], base: &Isometry3<f64>) -> Result<()> {
         self.check_posture("posture", posture)?;
         for (info, &q) in self.model.joints().iter().zip(posture) {
@@ -159,16 +171,33 @@ impl PhysicsSim {
                 });
             }
         }
-        let floating = self.options.root == RootMode::Floating;
+        self.teleport(posture, base);
+        Ok(())
+    }
+
+    /// Puts the robot at a posture it reached (a recorded path row, to draw it): as
+    /// [`World::reset_with_base`], but a joint may lie past its limit, as joints driven into
+    /// their stops do (by a few mrad).
+    pub fn place(&mut self, posture: &[f64], base: &Isometry3<f64>) -> Result<()> {
+        self.check_posture("posture", posture)?;
+        self.teleport(posture, base);
+        Ok(())
+    }
+
+    fn teleport(&mut self, posture: &[f64], base: &Isometry3<f64>) {
+        let floating = self.config.root == RootMode::Floating;
         if floating && let Some(rb) = self.world.bodies.get_mut(self.root) {
-            rb.set_position(crate::obstacles::to_pose(base), true);
+            rb.set_position(to_pose(base), true);
         }
         for (slot, &q) in self.slots.iter().zip(posture) {
             if let Some((mb, _)) = self.world.multibody_joints.get_mut(slot.handle)
                 && let Some(link) = mb.link_mut(slot.link_id)
             {
+                // Back to exactly 0 (x + (−x) = 0 in IEEE), then to exactly q: the coordinate is
+                // `q as f32` whatever the posture before, so a reset does not depend on history.
                 let current = link.joint.coords()[slot.axis as usize];
-                link.joint.apply_displacement(&[q as Real - current]);
+                link.joint.apply_displacement(&[-current]);
+                link.joint.apply_displacement(&[q as Real]);
             }
         }
         for slot in &self.slots {
@@ -191,7 +220,6 @@ impl PhysicsSim {
         }
         self.targets.copy_from_slice(posture);
         self.time = 0.0;
-        Ok(())
     }
 
     /// Sets every servo target (URDF joint order), clamped to the joint limits.
@@ -252,11 +280,11 @@ impl PhysicsSim {
         for _ in 0..n {
             self.world.step();
         }
-        self.time += n as f64 * self.options.dt;
+        self.time += n as f64 * self.config.physics.dt;
     }
 
     /// Advances the world by one RL step (`substeps` physics steps).
     pub fn step_rl(&mut self) {
-        self.step(self.options.substeps);
+        self.step(self.config.physics.substeps);
     }
 }

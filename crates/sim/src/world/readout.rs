@@ -4,18 +4,19 @@
 use nalgebra::{Isometry3, Point3};
 use rapier3d::prelude::RigidBodyHandle;
 
-use super::PhysicsSim;
+use super::World;
 use crate::error::{Result, SimError};
-use crate::urdf::{JointSlot, to_isometry};
+use crate::pose::to_isometry;
+use crate::urdf::JointSlot;
 
-/// A point fixed on a link: where to read a hand position. Made by [`PhysicsSim::frame`].
+/// A point fixed on a link: where to read a hand position. Made by [`World::frame`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frame {
     pub(crate) body: RigidBodyHandle,
     pub(crate) offset: Isometry3<f64>,
 }
 
-impl PhysicsSim {
+impl World {
     /// Writes the joint positions (URDF order) into `out` (length `num_joints`).
     pub fn joint_positions_into(&self, out: &mut [f64]) {
         for (o, slot) in out.iter_mut().zip(&self.slots) {
@@ -76,6 +77,22 @@ impl PhysicsSim {
     /// World pose of link `link` (its URDF link frame).
     pub fn link_pose(&self, link: &str) -> Result<Isometry3<f64>> {
         Ok(self.frame_pose(&self.frame(link, [0.0; 3])?))
+    }
+
+    /// World poses of every URDF link, in URDF link order (`None` for a link neither with a
+    /// body nor fixed to one).
+    pub fn link_poses(&self) -> Vec<Option<Isometry3<f64>>> {
+        self.frames
+            .iter()
+            .map(|f| {
+                f.and_then(|(body, offset)| {
+                    self.world
+                        .bodies
+                        .get(body)
+                        .map(|rb| to_isometry(rb.position()) * offset)
+                })
+            })
+            .collect()
     }
 
     /// World pose of the root link.

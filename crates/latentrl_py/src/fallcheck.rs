@@ -1,13 +1,14 @@
-//! Binding of `sim::humanoid`: the fall check of the floating humanoid in one call.
+//! Binding of `sim::fallcheck`: the fall check of a floating robot's task in one call.
 
-use ::sim::humanoid::{FallCheckConfig, run_fall_check_observed, sim_options};
-use ::sim::{PdGains, PhysicsSim, SimOptions};
+use ::sim::World;
+use ::sim::fallcheck::{FallCheckConfig, run_fall_check_observed};
 use nalgebra::DMatrix;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{points, to_points};
 use crate::errors::{InvalidInputError, guard, sim_to_py};
+use crate::task::PyTask;
 
 /// Columns of the returned table, one row per target.
 const COLUMNS: usize = 7;
@@ -18,11 +19,9 @@ const FRAME_HEAD: usize = 9;
 /// The fall check's per-target table and its recorded frames.
 type TableAndFrames<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
 
-/// Runs the fall check of `sim::humanoid::run_fall_check` on the URDF at `urdf_path`
-/// (floating root, ground at z = 0): stand at `start` `(D,)`, hold each row of `targets`
-/// `(M, D)` for `hold` s under PD servos (`kp` N·m/rad, `kd` N·m·s/rad, torque capped at
-/// `max_force` and at the URDF effort), physics step `dt`, `solver_iterations`,
-/// `pgs_iterations`.
+/// Runs the fall check (`sim::fallcheck::run_fall_check`) of `task` (a floating robot with a
+/// `[fall]` rule and a distance constraint, the grip): in the task's world, stand at `start`
+/// `(D,)`, hold each row of `targets` `(M, D)` for `hold` s.
 /// Returns `(table, frames)`. `table` `(M, 7)`: fell (0/1), smallest support margin (m),
 /// final support margin (m), grip error at the end (hand distance − `grip_width`, m),
 /// largest |grip error| (m), base height at the end (m), time of the fall (s since the
@@ -30,21 +29,13 @@ type TableAndFrames<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>
 /// the check reaches, taken at the first check (every 4 physics steps) at or after it: time
 /// (s), fell (0/1), base position (m), base quaternion (x, y, z, w), joint positions.
 #[pyfunction]
-#[pyo3(signature = (urdf_path, start, targets, *, hold, kp, kd, max_force, dt, solver_iterations, pgs_iterations, grip_width, record_times = Vec::new()))]
-#[allow(clippy::too_many_arguments)]
-pub fn humanoid_fall_check<'py>(
+#[pyo3(signature = (task, start, targets, *, hold, record_times = Vec::new()))]
+pub fn fall_check<'py>(
     py: Python<'py>,
-    urdf_path: &str,
+    task: &PyTask,
     start: PyReadonlyArray1<'py, f64>,
     targets: PyReadonlyArray2<'py, f64>,
     hold: f64,
-    kp: f64,
-    kd: f64,
-    max_force: f64,
-    dt: f64,
-    solver_iterations: usize,
-    pgs_iterations: usize,
-    grip_width: f64,
     record_times: Vec<f64>,
 ) -> PyResult<TableAndFrames<'py>> {
     guard(|| {
@@ -64,26 +55,16 @@ pub fn humanoid_fall_check<'py>(
             )));
         }
         let rows: Vec<Vec<f64>> = targets.column_iter().map(|c| c.iter().copied().collect()).collect();
-        let gains = PdGains::new(kp, kd, max_force).map_err(sim_to_py)?;
-        let options = SimOptions {
-            gains,
-            dt,
-            solver_iterations,
-            pgs_iterations,
-            ..sim_options()
-        };
-        let config = FallCheckConfig {
-            hold,
-            grip_width,
-            ..FallCheckConfig::default()
-        };
+        let task = &task.inner;
+        let config = FallCheckConfig::for_task(task, hold).map_err(sim_to_py)?;
+        let world = task.world_config();
+        let dt = world.physics.dt;
         let mut pending: Vec<f64> = record_times.iter().map(|t| (t / dt).round()).collect();
         pending.sort_by(|a, b| b.total_cmp(a));
         let mut frames: Vec<f64> = Vec::new();
-        let path = urdf_path.to_string();
         let reports = py
             .detach(|| {
-                let mut sim = PhysicsSim::from_urdf_file(&path, options)?;
+                let mut sim = World::new(task.model().clone(), world)?;
                 run_fall_check_observed(&mut sim, &start, &rows, &config, |sim, fell| {
                     let done = (sim.time() / dt).round();
                     while pending.last().is_some_and(|&step| done >= step) {

@@ -1,20 +1,13 @@
-//! The Experiment 2 plant (SPEC §4.2): two simulated arms holding an object, walls tested on
-//! the hands, drops, rewards, "passed", and whole trials (test episodes, determinism).
+//! The two-arms task (`tasks/two_arms.toml`, SPEC §4.2) on the generic task plant: walls tested
+//! on the hands, drops, rewards, "passed", and whole trials (test episodes, determinism).
 mod common;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
-use latent_core::episode::{EndReason, LearnerConfig, Plant, StartMode};
-use latent_core::trials::{TrialOptions, TrialResult};
-use latent_core::{GpMap, SeKernel};
+use latent_core::trials::{LatentSpace, TrialOptions, TrialResult, run_latent_trials};
+use latent_core::{EndReason, GpMap, LearnerConfig, Plant, SeKernel, StartMode};
 use nalgebra::DMatrix;
-use sim::PlanarArms;
-use sim::arms::{ArmsConfig, ArmsLatent, ArmsPlant};
-use sim::latent::run_latent_trials;
-
-fn plant(config: ArmsConfig) -> ArmsPlant {
-    ArmsPlant::new(common::arms_model(), config).expect("arms plant builds")
-}
+use sim::{PlanarArms, Task, TaskPlant};
 
 /// The posture (elbows outward) with the left hand at `(x, y)` and the right hand 0.1 m to its right.
 fn holding(x: f64, y: f64) -> [f64; 4] {
@@ -27,9 +20,16 @@ fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
     a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tol)
 }
 
+/// The hands `(x_L, y_L, x_R, y_R)` of the plant (the effectors lie in z = 0).
+fn hands(p: &TaskPlant) -> [f64; 4] {
+    let e = p.effectors();
+    assert_eq!((e[2], e[5]), (0.0, 0.0), "planar arms");
+    [e[0], e[1], e[3], e[4]]
+}
+
 /// Steps towards hands `(x, y)` along a straight line of `n` steps; returns every outcome
 /// and the largest joint tracking error |reached − target| seen.
-fn walk(p: &mut ArmsPlant, from: (f64, f64), to: (f64, f64), n: usize) -> (Vec<(f64, Option<EndReason>)>, f64) {
+fn walk(p: &mut TaskPlant, from: (f64, f64), to: (f64, f64), n: usize) -> (Vec<(f64, Option<EndReason>)>, f64) {
     let mut reached = [0.0; 4];
     let mut outcomes = Vec::new();
     let mut worst: f64 = 0.0;
@@ -52,7 +52,8 @@ fn walk(p: &mut ArmsPlant, from: (f64, f64), to: (f64, f64), n: usize) -> (Vec<(
 
 #[test]
 fn a_held_posture_stays_put_and_pays_the_formula() {
-    let mut p = plant(ArmsConfig::default());
+    let task = std::sync::Arc::new(common::task("two_arms"));
+    let mut p = TaskPlant::new(task.clone(), None).unwrap();
     let q = holding(-0.2, 0.2);
     assert_eq!(p.reset(&q), None);
     let expected_hands = PlanarArms::default().hands(&q);
@@ -60,7 +61,7 @@ fn a_held_posture_stays_put_and_pays_the_formula() {
     for _ in 0..40 {
         let out = p.step(&q, &mut reached);
         assert_eq!(out.end, None);
-        let h = p.hands();
+        let h = hands(&p);
         assert!(close(&reached, &q, 1e-4), "{reached:?} vs {q:?}");
         assert!(close(&h, &expected_hands, 1e-4), "{h:?} vs {expected_hands:?}");
         // Reward (SPEC §4.2): exp(−0.35 ‖(h − h*)/0.3‖²) of the sim's hand frames.
@@ -75,29 +76,38 @@ fn a_held_posture_stays_put_and_pays_the_formula() {
             out.reward
         );
     }
-    let mut task = [0.0; 4];
-    p.task_position(&mut task);
-    assert_eq!(task, p.hands());
+    let mut row = vec![0.0; p.task_dim()];
+    p.task_position(&mut row);
+    assert_eq!(row.len(), 6 + 7 + 4);
+    assert_eq!(&row[..6], p.effectors());
+    assert_eq!(
+        &row[6..13],
+        &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+        "the fixed base at the origin"
+    );
+    assert!(close(&row[13..], &reached, 0.0));
     assert!(!p.reached_target() && !p.passed() && p.admits_test_start());
 }
 
 #[test]
 fn hands_match_the_kinematics_of_the_reached_posture() {
-    let mut p = plant(ArmsConfig::default());
+    let task = std::sync::Arc::new(common::task("two_arms"));
+    let mut p = TaskPlant::new(task.clone(), None).unwrap();
     assert_eq!(p.reset(&holding(-0.2, 0.15)), None);
     let (outcomes, _) = walk(&mut p, (-0.2, 0.15), (-0.05, 0.25), 10);
     assert!(outcomes.iter().all(|(_, end)| end.is_none()));
     let mut q = [0.0; 4];
-    p.sim().joint_positions_into(&mut q);
+    p.world().joint_positions_into(&mut q);
     assert!(
-        close(&p.hands(), &PlanarArms::default().hands(&q), 1e-5),
+        close(&hands(&p), &PlanarArms::default().hands(&q), 1e-5),
         "f32 world vs f64 FK"
     );
 }
 
 #[test]
 fn passing_the_gap_reaches_the_target_and_counts_as_passed() {
-    let mut p = plant(ArmsConfig::default());
+    let task = std::sync::Arc::new(common::task("two_arms"));
+    let mut p = TaskPlant::new(task.clone(), None).unwrap();
     assert_eq!(p.reset(&holding(-0.25, 0.2)), None);
     assert!(p.admits_test_start(), "both hands below the wall");
     // Straight up through the gap x ∈ (−0.36, −0.06): 1 cm per 0.05 s step.
@@ -117,26 +127,25 @@ fn passing_the_gap_reaches_the_target_and_counts_as_passed() {
 
 #[test]
 fn a_target_inside_the_corridor_wall_ends_with_obstacle() {
-    let mut p = plant(ArmsConfig::default());
+    let task = std::sync::Arc::new(common::task("two_arms"));
+    let mut p = TaskPlant::new(task.clone(), None).unwrap();
     assert_eq!(p.reset(&holding(-0.4, 0.2)), None);
     let (outcomes, _) = walk(&mut p, (-0.4, 0.2), (-0.4, 0.34), 14);
     let (reward, end) = *outcomes.last().unwrap();
     assert_eq!(end, Some(EndReason::Obstacle), "{outcomes:?}");
-    let h = p.hands();
+    let h = hands(&p);
     assert!(
         (0.30..=0.37).contains(&h[1]) && h[0] <= -0.36,
         "left hand in the left wall: {h:?}"
     );
-    assert!(
-        (reward - (p.config().reward(&h) - 1.0)).abs() < 1e-12,
-        "reward + penalty"
-    );
+    assert!((reward - (p.reward() - 1.0)).abs() < 1e-12, "reward + penalty");
     assert!(!p.passed());
 }
 
 #[test]
 fn a_broken_grip_ends_with_drop() {
-    let mut p = plant(ArmsConfig::default());
+    let task = std::sync::Arc::new(common::task("two_arms"));
+    let mut p = TaskPlant::new(task.clone(), None).unwrap();
     let q = holding(-0.2, 0.2);
     assert_eq!(p.reset(&q), None);
     // Right hand 1 cm further right: the grip is off by 0.01 > 0.005.
@@ -144,7 +153,7 @@ fn a_broken_grip_ends_with_drop() {
     let mut reached = [0.0; 4];
     let out = p.step(&target, &mut reached);
     assert_eq!(out.end, Some(EndReason::Drop));
-    assert!((out.reward - (p.config().reward(&p.hands()) - 1.0)).abs() < 1e-12);
+    assert!((out.reward - (p.reward() - 1.0)).abs() < 1e-12);
     // 3 mm is within the tolerance.
     assert_eq!(p.reset(&q), None);
     let target = PlanarArms::default().inverse(&[-0.2, 0.2, -0.097, 0.2], 0).unwrap();
@@ -153,7 +162,8 @@ fn a_broken_grip_ends_with_drop() {
 
 #[test]
 fn inadmissible_starts_are_refused() {
-    let mut p = plant(ArmsConfig::default());
+    let task = std::sync::Arc::new(common::task("two_arms"));
+    let mut p = TaskPlant::new(task.clone(), None).unwrap();
     assert_eq!(p.reset(&holding(-0.4, 0.33)), Some(EndReason::Obstacle));
     let loose = PlanarArms::default().inverse(&[-0.2, 0.2, -0.05, 0.2], 0).unwrap();
     assert_eq!(p.reset(&loose), Some(EndReason::Drop));
@@ -166,22 +176,23 @@ fn inadmissible_starts_are_refused() {
 }
 
 #[test]
-fn bad_hand_links_and_configs_fail_to_build() {
-    let bad = ArmsConfig {
-        left_hand: "left_paw".to_string(),
-        ..ArmsConfig::default()
-    };
-    assert!(ArmsPlant::new(common::arms_model(), bad).is_err());
-    let bad = ArmsConfig {
-        start_posture: [9.0, 0.0, 0.0, 0.0],
-        ..ArmsConfig::default()
-    };
-    assert!(ArmsPlant::new(common::arms_model(), bad).is_err());
-    let bad = ArmsConfig {
-        theta: -1.0,
-        ..ArmsConfig::default()
-    };
-    assert!(ArmsPlant::new(common::arms_model(), bad).is_err());
+fn a_reset_does_not_depend_on_the_posture_before() {
+    let task = std::sync::Arc::new(common::task("two_arms"));
+    let mut a = TaskPlant::new(task.clone(), None).unwrap();
+    let mut b = TaskPlant::new(task.clone(), None).unwrap();
+    let q = holding(-0.2, 0.2);
+    let mut reached = [0.0; 4];
+    a.reset(&holding(-0.1, 0.1));
+    a.step(&holding(-0.12, 0.12), &mut reached);
+    a.reset(&q);
+    b.reset(&q);
+    let (ra, rb) = (a.world().joint_positions(), b.world().joint_positions());
+    assert_eq!(
+        ra.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        rb.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    );
+    let (sa, sb) = (a.step(&q, &mut reached), b.step(&q, &mut reached));
+    assert_eq!(sa.reward.to_bits(), sb.reward.to_bits());
 }
 
 /// GP maps over a 9×9 latent grid on [0, 1]²: the left hand at
@@ -204,19 +215,15 @@ fn gap_maps() -> (GpMap, GpMap) {
     )
 }
 
-fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
-    let plant = ArmsConfig {
-        drop_tolerance: 0.02,
-        ..ArmsConfig::default()
-    };
+fn run(threads: usize, task: &std::sync::Arc<Task>, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
     let config = LearnerConfig {
-        max_steps: 60,
-        step_fraction: 0.5,
-        beta: 20.0,
-        start: StartMode::UniformInBox,
-        ..LearnerConfig::default()
+        step: 0.5,
+        ..task.config().learner.clone()
     };
-    let latent = ArmsLatent {
+    let mut rules = task.episode_rules();
+    rules.max_steps = 60;
+    assert_eq!(rules.start, StartMode::Uniform);
+    let latent = LatentSpace {
         decoder,
         encoder,
         low: &[0.0, 0.0],
@@ -233,12 +240,12 @@ fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let done = AtomicUsize::new(0);
-    let model = common::arms_model();
     let results = pool
         .install(|| {
             run_latent_trials(
-                |_| ArmsPlant::new(model.clone(), plant.clone()),
+                |_| TaskPlant::new(task.clone(), None),
                 &config,
+                rules,
                 &latent,
                 &options,
                 &AtomicBool::new(false),
@@ -252,29 +259,33 @@ fn run(threads: usize, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
 
 #[test]
 fn trials_run_test_episodes_from_below_the_wall_and_repeat_bitwise() {
+    let mut config = common::task("two_arms").config().clone();
+    config.constraints[0].tolerance = Some(0.02);
+    let task = std::sync::Arc::new(
+        Task::from_config(config, std::path::Path::new(common::TASKS), "two_arms, grip 0.02").unwrap(),
+    );
     let (decoder, encoder) = gap_maps();
-    let one = run(1, &decoder, &encoder);
-    let two = run(2, &decoder, &encoder);
+    let one = run(1, &task, &decoder, &encoder);
+    let two = run(2, &task, &decoder, &encoder);
     assert_eq!(one, two, "1 vs 2 threads");
+    let row = task.row_len();
     for r in &one {
         assert!(r.finished);
         assert_eq!((r.episodes.len(), r.tests.len(), r.test_trajectories.len()), (6, 4, 2));
         for path in &r.test_trajectories {
             assert!(
-                path[1] < 0.30 && path[3] < 0.30,
+                path[1] < 0.30 && path[4] < 0.30,
                 "test start above the wall band: {:?}",
-                &path[..4]
+                &path[..6]
             );
         }
         for rec in r.tests.iter().chain(&r.episodes) {
             assert!(rec.steps >= 1 && rec.steps <= 60);
         }
-    }
-    // Recorded test paths and flags agree.
-    for r in &one {
+        // Recorded test paths and flags agree.
         for (slot, e) in [0, 3].into_iter().enumerate() {
             let path = &r.test_trajectories[slot];
-            let above = path.chunks_exact(4).skip(1).any(|h| h[1] > 0.37 && h[3] > 0.37);
+            let above = path.chunks_exact(row).skip(1).any(|h| h[1] > 0.37 && h[4] > 0.37);
             assert_eq!(r.tests[e].passed, above);
         }
     }

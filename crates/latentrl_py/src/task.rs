@@ -1,0 +1,638 @@
+//! Binding of `sim::task`: a task (file or dict) as `Task`, its plant as `TaskPlant`, its
+//! trials in one call, and the schema of its keys.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use ::sim::task::{
+    ConstraintConfig, FallConfig, FloorConfig, ObstacleConfig, Task, TaskConfig, TaskPlant, WaypointConfig,
+};
+use ::sim::world::JointServo;
+use latent_core::trials::LatentSpace;
+use latent_core::{EndReason, Learner, Phase, Plant, trial_rng};
+use nalgebra::DMatrix;
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::convert::{config_from, config_to, points, to_points};
+use crate::errors::{guard, sim_to_py, to_py};
+use crate::runner::{RunArgs, check_recording, gp_map, invalid, latent_args, pack_results, run_with_polling};
+
+/// `classify`'s result: one code per posture and the effector positions.
+type CodesAndEffectors<'py> = (Bound<'py, PyArray1<i8>>, Bound<'py, PyArray2<f64>>);
+
+/// A checked task: its configuration and its robot (docs/tasks.md).
+#[pyclass(name = "Task", module = "latentrl._native", frozen)]
+pub struct PyTask {
+    pub inner: Arc<Task>,
+}
+
+fn code(end: Option<EndReason>) -> Option<u8> {
+    end.map(EndReason::code)
+}
+
+#[pymethods]
+impl PyTask {
+    /// Reads a TOML task file (the URDF path relative to its folder).
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        guard(|| {
+            let task = py.detach(|| Task::load(&path)).map_err(sim_to_py)?;
+            Ok(Self { inner: Arc::new(task) })
+        })
+    }
+
+    /// A task from a dict of task-file keys; the URDF path is relative to `base_dir`, `origin`
+    /// names the task in errors.
+    #[staticmethod]
+    #[pyo3(signature = (config, base_dir = PathBuf::from("."), origin = "<dict>"))]
+    fn from_dict(py: Python<'_>, config: &Bound<'_, PyAny>, base_dir: PathBuf, origin: &str) -> PyResult<Self> {
+        guard(|| {
+            let config: TaskConfig = config_from(origin, config)?;
+            let task = py
+                .detach(|| Task::from_config(config, &base_dir, origin))
+                .map_err(sim_to_py)?;
+            Ok(Self { inner: Arc::new(task) })
+        })
+    }
+
+    /// Every key with its effective value, as a dict of task-file keys.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        guard(|| config_to(py, self.inner.config()))
+    }
+
+    /// The task's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.config().name.clone()
+    }
+
+    /// Where the task came from (its file, or the name given).
+    #[getter]
+    fn origin(&self) -> String {
+        self.inner.origin().to_string()
+    }
+
+    /// Names of the robot's actuated joints, the columns of its postures.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        crate::convert::owned(self.inner.model().joint_names())
+    }
+
+    /// Names of every URDF link, in URDF order.
+    #[getter]
+    fn link_names(&self) -> Vec<String> {
+        crate::convert::owned(self.inner.model().link_names())
+    }
+
+    /// `(parent link, child link)` of every URDF joint: the kinematic tree.
+    #[getter]
+    fn edges(&self) -> Vec<(String, String)> {
+        self.inner
+            .model()
+            .edges()
+            .into_iter()
+            .map(|(a, b)| (a.to_string(), b.to_string()))
+            .collect()
+    }
+
+    /// Every collision shape: dicts `{link, kind, size, origin}` (origin: the pose in the link's
+    /// frame, position and quaternion x, y, z, w), to draw the robot.
+    fn collision_shapes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let names = self.inner.model().link_names();
+        let out = PyList::empty(py);
+        for s in self.inner.model().collision_shapes() {
+            let d = PyDict::new(py);
+            d.set_item("link", names[s.link])?;
+            d.set_item("kind", s.kind)?;
+            d.set_item("size", s.size)?;
+            let t = s.origin.translation.vector;
+            let q = s.origin.rotation.coords;
+            d.set_item("origin", vec![t.x, t.y, t.z, q.x, q.y, q.z, q.w])?;
+            out.append(d)?;
+        }
+        Ok(out)
+    }
+
+    /// The names of the task's effectors.
+    #[getter]
+    fn effectors(&self) -> Vec<String> {
+        self.inner.config().effectors.clone()
+    }
+
+    /// Lower joint limits (rad or m; -inf for continuous joints).
+    #[getter]
+    fn lower<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.model().joints().iter().map(|j| j.lower).collect())
+    }
+
+    /// Upper joint limits.
+    #[getter]
+    fn upper<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.model().joints().iter().map(|j| j.upper).collect())
+    }
+
+    /// Columns of a recorded path row: 3 per effector, base pose (7), joints.
+    #[getter]
+    fn row_len(&self) -> usize {
+        self.inner.row_len()
+    }
+
+    /// Duration of one RL step (s).
+    #[getter]
+    fn rl_dt(&self) -> f64 {
+        self.inner.world_config().rl_dt()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Task({:?}, robot={:?}, joints={}, effectors={:?})",
+            self.inner.config().name,
+            self.inner.model().name(),
+            self.inner.model().joints().len(),
+            self.inner.config().effectors
+        )
+    }
+}
+
+/// Rows of a `(N, D)` array of postures, or None.
+fn rows(name: &str, array: Option<PyReadonlyArray2<'_, f64>>) -> PyResult<Option<Vec<Vec<f64>>>> {
+    array
+        .map(|a| {
+            let m = points(name, &a)?;
+            Ok(m.column_iter().map(|c| c.iter().copied().collect()).collect())
+        })
+        .transpose()
+}
+
+/// The robot of a task in its world: the one plant of the learner, the environments and the
+/// figures (docs/tasks.md has the rules it applies).
+#[pyclass(name = "TaskPlant", module = "latentrl._native")]
+pub struct PyTaskPlant {
+    inner: TaskPlant,
+}
+
+#[pymethods]
+impl PyTaskPlant {
+    /// The task's robot standing at its home posture: demo `episode.start_demo` of `demos`
+    /// `(N, D)` if given, else zeros clamped into the limits.
+    #[new]
+    #[pyo3(signature = (task, demos = None))]
+    fn new(py: Python<'_>, task: &PyTask, demos: Option<PyReadonlyArray2<'_, f64>>) -> PyResult<Self> {
+        guard(|| {
+            let demos = rows("demos", demos)?;
+            let task = Arc::clone(&task.inner);
+            let inner = py
+                .detach(|| TaskPlant::new(task, demos.as_deref()))
+                .map_err(sim_to_py)?;
+            Ok(Self { inner })
+        })
+    }
+
+    /// Puts the robot at `posture` (D,); returns None if it may start an episode, else the code
+    /// of the rule it breaks (END_REASONS: 1 obstacle, 2 outside the joint limits, 3 drop, 4 fall).
+    fn reset(&mut self, posture: PyReadonlyArray1<'_, f64>) -> PyResult<Option<u8>> {
+        guard(|| Ok(code(self.inner.reset(&posture.as_array().to_vec()))))
+    }
+
+    /// Tracks `target` (D,) for one RL step: `(reward, end code or None, reached posture (D,))`.
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        target: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<(f64, Option<u8>, Bound<'py, PyArray1<f64>>)> {
+        guard(|| {
+            let target = target.as_array().to_vec();
+            let d = self.inner.posture_dim();
+            if target.len() != d {
+                return Err(invalid(format!(
+                    "target: expected shape ({d},), got ({},)",
+                    target.len()
+                )));
+            }
+            let mut reached = vec![0.0; d];
+            let inner = &mut self.inner;
+            let out = py.detach(|| inner.step(&target, &mut reached));
+            Ok((out.reward, code(out.end), PyArray1::from_vec(py, reached)))
+        })
+    }
+
+    /// For each posture of `postures` (M, D) at rest: the code of the rule it breaks (0: none;
+    /// 1 obstacle, 2 outside the joint limits, 3 drop, 4 fall) and the effector positions (M, 3E).
+    fn classify<'py>(
+        &mut self,
+        py: Python<'py>,
+        postures: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<CodesAndEffectors<'py>> {
+        guard(|| {
+            let postures = points("postures", &postures)?;
+            let d = self.inner.posture_dim();
+            if postures.nrows() != d {
+                return Err(invalid(format!(
+                    "postures: expected shape (M, {d}), got ({}, {})",
+                    postures.ncols(),
+                    postures.nrows()
+                )));
+            }
+            let inner = &mut self.inner;
+            let (codes, effectors) = py.detach(|| {
+                let mut codes = Vec::with_capacity(postures.ncols());
+                let mut effectors = Vec::new();
+                for q in postures.column_iter() {
+                    let q: Vec<f64> = q.iter().copied().collect();
+                    codes.push(inner.reset(&q).map_or(0, |e| e.code() as i8));
+                    effectors.extend_from_slice(inner.effectors());
+                }
+                (codes, effectors)
+            });
+            let e = self.inner.effectors().len();
+            let effectors = DMatrix::from_vec(e, codes.len(), effectors);
+            Ok((PyArray1::from_vec(py, codes), to_points(py, effectors)?))
+        })
+    }
+
+    /// A start posture drawn by the task's start rule (its home plus ±`episode.start_noise`
+    /// uniform noise per joint) from ChaCha8 seeded with `seed`.
+    fn sample_start<'py>(&mut self, py: Python<'py>, seed: u64) -> Bound<'py, PyArray1<f64>> {
+        let mut posture = vec![0.0; self.inner.posture_dim()];
+        self.inner.sample_start(&mut trial_rng(seed, 0), &mut posture);
+        PyArray1::from_vec(py, posture)
+    }
+
+    /// The effector positions (3E,): x, y, z per effector.
+    fn effectors<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.effectors().to_vec())
+    }
+
+    /// The reached joint positions (D,).
+    fn joint_positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.world().joint_positions())
+    }
+
+    /// The servo targets after clamping (D,).
+    fn targets<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.world().targets().to_vec())
+    }
+
+    /// The task-space row recorded in paths: effectors, base position and quaternion (x, y, z,
+    /// w), joints.
+    fn row<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let mut row = vec![0.0; self.inner.task_dim()];
+        self.inner.task_position(&mut row);
+        PyArray1::from_vec(py, row)
+    }
+
+    /// World poses (L, 7) of every URDF link (position, quaternion x, y, z, w), in the order of
+    /// `Task.link_names`; NaN for a link without a body.
+    fn link_poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let poses = self.inner.world().link_poses();
+        let mut out = Vec::with_capacity(7 * poses.len());
+        for pose in &poses {
+            match pose {
+                Some(p) => {
+                    out.extend(p.translation.vector.iter());
+                    out.extend(p.rotation.coords.iter());
+                }
+                None => out.extend([f64::NAN; 7]),
+            }
+        }
+        to_points(py, DMatrix::from_vec(7, poses.len(), out))
+    }
+
+    /// Each constraint's error now (distance: signed m; offset: m; orientation: rad; plane: m
+    /// outside the bounds), in task-file order.
+    fn constraint_errors<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.inner.constraint_errors())
+    }
+
+    /// The static support margin now (m, positive inside the soles' polygon; needs a fall rule).
+    fn support_margin(&self) -> PyResult<f64> {
+        guard(|| self.inner.support_margin().map_err(sim_to_py))
+    }
+
+    /// Link poses (L, 7) of the robot at `joints` (D,) with its base at `base` (7,: position,
+    /// quaternion x, y, z, w; ignored for a fixed root): the native kinematics of a recorded
+    /// path row, to draw it. Moves the robot there.
+    fn pose_links<'py>(
+        &mut self,
+        py: Python<'py>,
+        base: PyReadonlyArray1<'py, f64>,
+        joints: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        guard(|| {
+            let b = crate::convert::fixed::<7>("base", &base)?;
+            let rotation = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(b[6], b[3], b[4], b[5]));
+            let pose = nalgebra::Isometry3::from_parts(nalgebra::Translation3::new(b[0], b[1], b[2]), rotation);
+            self.inner
+                .place(&joints.as_array().to_vec(), &pose)
+                .map_err(sim_to_py)?;
+            self.link_poses(py)
+        })
+    }
+
+    /// The robot's centre of mass now (3,), from the URDF inertials.
+    fn center_of_mass<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        guard(|| {
+            Ok(PyArray1::from_vec(
+                py,
+                self.inner.center_of_mass().map_err(sim_to_py)?.to_vec(),
+            ))
+        })
+    }
+
+    /// The reward now.
+    fn reward(&self) -> f64 {
+        self.inner.reward()
+    }
+
+    /// Whether the effectors are within the task's reach radius of the target.
+    fn reached(&self) -> bool {
+        self.inner.reached_target()
+    }
+}
+
+/// One trial runner for every task: trials of the task's latent learner (`task.learner`,
+/// `task.episode`) in parallel in Rust, one plant per trial (a fresh world per episode for a
+/// floating robot).
+///
+/// task: a Task. decoder, encoder: GpMap latent (d) → posture (D) and back. latent_low,
+/// latent_high: (d,) corners of the latent box. demos: (N, D) demonstrations (a "demo" start
+/// uses row `episode.start_demo`). weights: (M,) value weights to start from (a saved policy;
+/// default w₀ everywhere). rollout: run the `episodes` frozen with the greedy policy.
+/// n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
+/// record_test_episodes, return_weights, progress: as for run_bimanual_trials.
+///
+/// Returns the dict of run_bimanual_trials with paths of `task.row_len` columns (effectors,
+/// base pose, joints) and "task" (the effective task as a dict).
+#[pyfunction]
+#[pyo3(signature = (
+    task, *, decoder, encoder, latent_low, latent_high, n_trials, episodes, base_seed, demos = None,
+    weights = None, rollout = false, first_trial = None, record_episodes = None, test_episodes = None,
+    record_test_episodes = None, return_weights = false, progress = None,
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn run_task_trials<'py>(
+    py: Python<'py>,
+    task: &PyTask,
+    decoder: Bound<'py, PyAny>,
+    encoder: Bound<'py, PyAny>,
+    latent_low: &Bound<'py, PyAny>,
+    latent_high: &Bound<'py, PyAny>,
+    n_trials: &Bound<'py, PyAny>,
+    episodes: &Bound<'py, PyAny>,
+    base_seed: &Bound<'py, PyAny>,
+    demos: Option<PyReadonlyArray2<'py, f64>>,
+    weights: Option<PyReadonlyArray1<'py, f64>>,
+    rollout: bool,
+    first_trial: Option<&Bound<'py, PyAny>>,
+    record_episodes: Option<&Bound<'py, PyAny>>,
+    test_episodes: Option<&Bound<'py, PyAny>>,
+    record_test_episodes: Option<&Bound<'py, PyAny>>,
+    return_weights: bool,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    guard(|| {
+        #[rustfmt::skip]
+        let mut run = RunArgs { n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
+                                record_test_episodes, return_weights, progress }.check()?;
+        if rollout {
+            run.options.phase = Phase::Rollout;
+        }
+        let task = Arc::clone(&task.inner);
+        let demos = rows("demos", demos)?;
+        let [decoder, encoder] = [Some(decoder), Some(encoder)];
+        let maps = latent_args(
+            gp_map("decoder", &decoder)?,
+            gp_map("encoder", &encoder)?,
+            Some(latent_low),
+            Some(latent_high),
+            "",
+        )?;
+        let latent = LatentSpace {
+            decoder: maps.decoder,
+            encoder: maps.encoder,
+            low: &maps.low,
+            high: &maps.high,
+        };
+        let config = &task.config().learner;
+        let rules = task.episode_rules();
+        // One plant and the learner up front: a bad task, demos or maps fail before any trial.
+        let probe = TaskPlant::new(Arc::clone(&task), demos.as_deref()).map_err(sim_to_py)?;
+        let mut template = Learner::new(config, rules, latent.low, latent.high).map_err(to_py)?;
+        template
+            .check_space(&latent.space(), probe.posture_dim())
+            .map_err(to_py)?;
+        drop(probe);
+        if let Some(w) = &weights {
+            template.set_weights(&w.as_array().to_vec()).map_err(to_py)?;
+        }
+        let options = &run.options;
+        check_recording(options, rules.max_steps, task.row_len())?;
+        let make_plant = |_| TaskPlant::new(Arc::clone(&task), demos.as_deref());
+        let results = run_with_polling(py, options, run.progress.as_ref(), |cancel, done| {
+            let make = |trial| make_plant(trial).map_err(|e| latent_core::CoreError::Plant { reason: e.to_string() });
+            latent_core::trials::run_trials(&template, &latent.space(), make, options, cancel, done)
+        })?;
+        let out = pack_results(py, &results, &template, options, task.row_len())?;
+        out.set_item("task", config_to(py, task.config())?)?;
+        Ok(out)
+    })
+}
+
+/// V(z) = wᵀ b(z) (Eq. 7) at `points` (M, d) for the learner `learner` (a dict of LearnerConfig
+/// keys) over the latent box [low, high] with weights (M',): the learner's own sparse features,
+/// as its look-ahead sees them.
+#[pyfunction]
+pub fn learner_values<'py>(
+    py: Python<'py>,
+    learner: &Bound<'py, PyAny>,
+    low: Vec<f64>,
+    high: Vec<f64>,
+    weights: PyReadonlyArray1<'py, f64>,
+    points: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    guard(|| {
+        let config: latent_core::LearnerConfig = config_from("learner", learner)?;
+        let mut l = Learner::new(&config, Default::default(), &low, &high).map_err(to_py)?;
+        l.set_weights(&weights.as_array().to_vec()).map_err(to_py)?;
+        let z = crate::convert::points("points", &points)?;
+        if z.nrows() != low.len() {
+            return Err(invalid(format!(
+                "points: expected shape (M, {}), got ({}, {})",
+                low.len(),
+                z.ncols(),
+                z.nrows()
+            )));
+        }
+        let values = py.detach(|| l.values(z.as_slice())).map_err(to_py)?;
+        Ok(PyArray1::from_vec(py, values))
+    })
+}
+
+/// `{key, doc, rule, kind, default}` of each key in `fields`, its default read from the tables
+/// of `defaults` (key prefix → default table as a dict; "" the top).
+fn schema_list<'py>(
+    py: Python<'py>,
+    fields: Vec<(String, latent_core::FieldInfo)>,
+    defaults: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyList>> {
+    let out = PyList::empty(py);
+    for (key, field) in fields {
+        let entry = PyDict::new(py);
+        entry.set_item("key", &key)?;
+        entry.set_item("doc", &field.doc)?;
+        entry.set_item("rule", field.rule.to_string())?;
+        entry.set_item("kind", &field.kind)?;
+        let table = key.rsplit_once('.').map_or("", |(t, _)| t);
+        let default = match defaults.get_item(table)? {
+            Some(d) => d.get_item(field.name).ok(),
+            None => defaults
+                .get_item("")?
+                .and_then(|top| table.split('.').try_fold(top, |d, k| d.get_item(k).ok()))
+                .and_then(|d| d.get_item(field.name).ok()),
+        };
+        entry.set_item("default", default)?;
+        out.append(entry)?;
+    }
+    Ok(out)
+}
+
+/// Every key of a task file as dicts `{key, doc, rule, kind, default}`, table by table: the
+/// source of docs/tasks.md and of the CLI's flags.
+#[pyfunction]
+pub fn task_schema<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+    guard(|| {
+        let defaults = PyDict::new(py);
+        defaults.set_item("", config_to(py, &TaskConfig::default())?)?;
+        defaults.set_item("floor", config_to(py, &FloorConfig::default())?)?;
+        defaults.set_item("servo.joints.NAME", config_to(py, &JointServo::default())?)?;
+        defaults.set_item("constraints[]", config_to(py, &ConstraintConfig::default())?)?;
+        defaults.set_item("obstacles[]", config_to(py, &ObstacleConfig::default())?)?;
+        defaults.set_item("waypoint", config_to(py, &WaypointConfig::default())?)?;
+        defaults.set_item("fall", config_to(py, &FallConfig::default())?)?;
+        schema_list(py, TaskConfig::schema(), &defaults)
+    })
+}
+
+/// The keys of Experiment 1's configuration (`plant.*`: the bimanual toy, `learner.*`), as
+/// `task_schema`.
+#[pyfunction]
+pub fn bimanual_schema<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+    use latent_core::Params;
+    guard(|| {
+        let defaults = PyDict::new(py);
+        defaults.set_item("plant", config_to(py, &::sim::BimanualConfig::default())?)?;
+        defaults.set_item("learner", config_to(py, &latent_core::LearnerConfig::default())?)?;
+        let prefixed = |prefix: &str, fields: Vec<latent_core::FieldInfo>| {
+            fields
+                .into_iter()
+                .map(|f| (format!("{prefix}.{}", f.name), f))
+                .collect::<Vec<_>>()
+        };
+        let mut fields = prefixed("plant", ::sim::BimanualConfig::fields());
+        fields.extend(prefixed("learner", latent_core::LearnerConfig::fields()));
+        schema_list(py, fields, &defaults)
+    })
+}
+
+/// The end reasons by code: their names in results files (0 timeout … 5 variance_gate).
+#[pyfunction]
+pub fn end_reasons() -> Vec<&'static str> {
+    EndReason::ALL.iter().map(|e| e.name()).collect()
+}
+
+/// A trained latent policy: the learner's grid and weights over the latent box with the GPLVM's
+/// maps; it acts greedily (the action of the largest look-ahead value).
+#[pyclass(name = "LatentPolicy", module = "latentrl._native", frozen)]
+pub struct PyLatentPolicy {
+    learner: Learner,
+    decoder: Py<crate::gp::PyGpMap>,
+    encoder: Py<crate::gp::PyGpMap>,
+}
+
+#[pymethods]
+impl PyLatentPolicy {
+    /// The policy of `learner` (a dict of LearnerConfig keys) over [low, high] with `weights`,
+    /// decoding with `decoder` (latent → posture) and encoding with `encoder`.
+    #[new]
+    fn new(
+        learner: &Bound<'_, PyAny>,
+        low: Vec<f64>,
+        high: Vec<f64>,
+        weights: PyReadonlyArray1<'_, f64>,
+        decoder: Bound<'_, crate::gp::PyGpMap>,
+        encoder: Bound<'_, crate::gp::PyGpMap>,
+    ) -> PyResult<Self> {
+        guard(|| {
+            let config: latent_core::LearnerConfig = config_from("learner", learner)?;
+            let mut l = Learner::new(&config, Default::default(), &low, &high).map_err(to_py)?;
+            l.set_weights(&weights.as_array().to_vec()).map_err(to_py)?;
+            let space = latent_core::StateSpace::Latent {
+                decoder: &decoder.get().inner,
+                encoder: &encoder.get().inner,
+            };
+            l.check_space(&space, decoder.get().inner.output_dim()).map_err(to_py)?;
+            Ok(Self {
+                learner: l,
+                decoder: decoder.unbind(),
+                encoder: encoder.unbind(),
+            })
+        })
+    }
+
+    /// The next servo target for the reached `posture` (D,): encode it, take the greedy latent
+    /// step (clamped into the box), decode. Returns `(target (D,), z (d,), next z (d,))`.
+    #[allow(clippy::type_complexity)]
+    fn act<'py>(
+        &self,
+        py: Python<'py>,
+        posture: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<(
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+        Bound<'py, PyArray1<f64>>,
+    )> {
+        guard(|| {
+            let (decoder, encoder) = (&self.decoder.get().inner, &self.encoder.get().inner);
+            let x = posture.as_array().to_vec();
+            if x.len() != encoder.input_dim() {
+                return Err(invalid(format!(
+                    "posture: expected shape ({},), got ({},)",
+                    encoder.input_dim(),
+                    x.len()
+                )));
+            }
+            latent_core::error::check_finite("posture", &x).map_err(to_py)?;
+            let mut z = vec![0.0; encoder.output_dim()];
+            encoder.mean_into(&x, &mut z, &mut encoder.scratch());
+            let next = self.learner.greedy_target(&z).map_err(to_py)?;
+            let mut target = vec![0.0; decoder.output_dim()];
+            decoder.mean_into(&next, &mut target, &mut decoder.scratch());
+            Ok((
+                PyArray1::from_vec(py, target),
+                PyArray1::from_vec(py, z),
+                PyArray1::from_vec(py, next),
+            ))
+        })
+    }
+
+    /// V(z) at `points` (M, d): the learner's own values.
+    fn values<'py>(&self, py: Python<'py>, points: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        guard(|| {
+            let z = crate::convert::points("points", &points)?;
+            let dim = self.learner.grid().dim();
+            if z.nrows() != dim {
+                return Err(invalid(format!(
+                    "points: expected shape (M, {dim}), got ({}, {})",
+                    z.ncols(),
+                    z.nrows()
+                )));
+            }
+            Ok(PyArray1::from_vec(
+                py,
+                self.learner.values(z.as_slice()).map_err(to_py)?,
+            ))
+        })
+    }
+}

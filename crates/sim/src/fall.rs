@@ -1,0 +1,256 @@
+//! Standing and falling (SPEC §4.3): the fall test of a free-floating robot, its centre of
+//! mass and static support margin, and a reset that stands it on a floor.
+//!
+//! - **Fall** ([`FallCriteria`]): a sole tilting more than its limit (20° for the humanoid),
+//!   a non-sole link touching the floor, or the base below a height (half its standing one).
+//! - **Centre of mass** ([`center_of_mass`]): the mass-weighted mean of the URDF
+//!   `<inertial>` origins at the current link poses (not rapier's body masses, which
+//!   read differently before the first step, PITFALLS.md).
+//! - **Support margin** ([`support_margin`]): signed distance (m) from the centre of mass
+//!   projected on the floor to the edge of the support polygon, positive inside. The polygon
+//!   is the 2-D convex hull of the bottom corners of the sole boxes that are within
+//!   [`SOLE_CONTACT_TOLERANCE`] of the lowest sole corner (a tipping foot keeps only its
+//!   touching edge).
+
+use latent_core::CoreError;
+use nalgebra::{Isometry3, Point2, Point3, Translation3, UnitQuaternion, Vector3};
+use rapier3d_urdf::urdf_rs;
+
+use crate::error::{Result, SimError, check_finite};
+use crate::urdf::UrdfModel;
+use crate::world::World;
+
+/// Sole corners up to this far (m) above the lowest sole corner count as touching.
+pub const SOLE_CONTACT_TOLERANCE: f64 = 2e-3;
+
+/// Thresholds of the fall test for a free-floating robot (SPEC §4.3: a sole tilting
+/// more than 20°, a non-sole body touching the floor, or the base height halving).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FallCriteria {
+    /// The robot has fallen when the root link's origin is lower than this (m).
+    pub min_base_height: f64,
+    /// … or when a sole's +z axis leans more than this from the world +z (rad).
+    pub max_sole_tilt: f64,
+    /// Links allowed to touch the ground (the soles); any other link touching it is a fall.
+    pub soles: Vec<String>,
+}
+
+/// The fall test's verdict and the quantities behind it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FallStatus {
+    /// Any criterion met.
+    pub fell: bool,
+    /// Height of the root link's origin (m).
+    pub base_height: f64,
+    /// Largest sole tilt (rad; 0 without soles).
+    pub sole_tilt: f64,
+    /// First non-sole link touching the ground, if any.
+    pub ground_contact: Option<String>,
+}
+
+impl World {
+    /// Evaluates `criteria` at the current state; fails on an unknown sole link.
+    pub fn fall_status(&self, criteria: &FallCriteria) -> Result<FallStatus> {
+        check_finite("fall criteria", &[criteria.min_base_height, criteria.max_sole_tilt])?;
+        let base_height = self.base_pose().translation.z;
+        let mut sole_tilt: f64 = 0.0;
+        for sole in &criteria.soles {
+            let up = self.link_pose(sole)?.rotation * nalgebra::Vector3::z();
+            sole_tilt = sole_tilt.max(up.z.clamp(-1.0, 1.0).acos());
+        }
+        let mut ground_contact = None;
+        for name in self.model.link_names() {
+            if !criteria.soles.iter().any(|s| s == name) && self.touching_ground(name)? {
+                ground_contact = Some(name.to_string());
+                break;
+            }
+        }
+        let fell =
+            base_height < criteria.min_base_height || sole_tilt > criteria.max_sole_tilt || ground_contact.is_some();
+        Ok(FallStatus {
+            fell,
+            base_height,
+            sole_tilt,
+            ground_contact,
+        })
+    }
+}
+
+/// Centre of mass of the whole robot in world coordinates (m), from the URDF inertials.
+pub fn center_of_mass(sim: &World) -> Result<Point3<f64>> {
+    let mut total = 0.0;
+    let mut sum = Vector3::zeros();
+    for link in &sim.model.robot.links {
+        let m = link.inertial.mass.value;
+        if m <= 0.0 {
+            continue;
+        }
+        let [x, y, z] = link.inertial.origin.xyz.0;
+        let p = sim.link_pose(&link.name)? * Point3::new(x, y, z);
+        sum += m * p.coords;
+        total += m;
+    }
+    if total <= 0.0 {
+        return Err(SimError::Input(CoreError::InvalidParameter {
+            name: "mass",
+            value: total,
+            reason: "the robot has no mass",
+        }));
+    }
+    Ok(Point3::from(sum / total))
+}
+
+/// World corners of every box collision shape of link `link`.
+fn box_corners(sim: &World, model: &UrdfModel, link: &str) -> Result<Vec<Point3<f64>>> {
+    let pose = sim.link_pose(link)?;
+    let urdf = model
+        .robot
+        .links
+        .iter()
+        .find(|l| l.name == link)
+        .ok_or_else(|| SimError::UnknownLink {
+            name: link.to_string(),
+            known: "URDF links".to_string(),
+        })?;
+    let mut out = Vec::new();
+    for c in &urdf.collision {
+        if let urdf_rs::Geometry::Box { size } = &c.geometry {
+            let [sx, sy, sz] = size.0;
+            let [x, y, z] = c.origin.xyz.0;
+            let [r, p, w] = c.origin.rpy.0;
+            let local = Isometry3::from_parts(Translation3::new(x, y, z), UnitQuaternion::from_euler_angles(r, p, w));
+            for i in 0..8 {
+                let sign = |bit: usize| if i & bit == 0 { -0.5 } else { 0.5 };
+                let corner = Point3::new(sign(1) * sx, sign(2) * sy, sign(4) * sz);
+                out.push(pose * local * corner);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// 2-D convex hull (Andrew's monotone chain), counter-clockwise, no repeated point.
+fn convex_hull(mut pts: Vec<Point2<f64>>) -> Vec<Point2<f64>> {
+    pts.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    pts.dedup_by(|a, b| (*a - *b).norm() < 1e-9);
+    if pts.len() < 3 {
+        return pts;
+    }
+    let cross = |o: Point2<f64>, a: Point2<f64>, b: Point2<f64>| (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+    let mut hull: Vec<Point2<f64>> = Vec::with_capacity(2 * pts.len());
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &Point2<f64>>> = if pass == 0 {
+            Box::new(pts.iter())
+        } else {
+            Box::new(pts.iter().rev())
+        };
+        for &p in iter {
+            while hull.len() >= start + 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0 {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+/// Distance from `p` to the segment `a`–`b`.
+fn segment_distance(p: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> f64 {
+    let ab = b - a;
+    let len2 = ab.norm_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + t * ab)).norm()
+}
+
+/// Signed distance (m) from `p` to the boundary of the counter-clockwise polygon `hull`,
+/// positive inside; for fewer than 3 vertices the negated distance to the point/segment.
+pub fn polygon_margin(p: Point2<f64>, hull: &[Point2<f64>]) -> f64 {
+    match hull.len() {
+        0 => f64::NEG_INFINITY,
+        1 => -(p - hull[0]).norm(),
+        2 => -segment_distance(p, hull[0], hull[1]),
+        n => {
+            let mut dist = f64::INFINITY;
+            let mut inside = true;
+            for i in 0..n {
+                let (a, b) = (hull[i], hull[(i + 1) % n]);
+                dist = dist.min(segment_distance(p, a, b));
+                let e = b - a;
+                if e.x * (p.y - a.y) - e.y * (p.x - a.x) < 0.0 {
+                    inside = false;
+                }
+            }
+            if inside { dist } else { -dist }
+        }
+    }
+}
+
+/// Support margin (m) of the current state: see the module docs. Fails on an unknown
+/// sole link; `-∞` when the soles have no box shape.
+pub fn support_margin(sim: &World, soles: &[String]) -> Result<f64> {
+    let mut corners = Vec::new();
+    for sole in soles {
+        corners.extend(box_corners(sim, &sim.model, sole)?);
+    }
+    let lowest = corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
+    let touching: Vec<Point2<f64>> = corners
+        .iter()
+        .filter(|c| c.z <= lowest + SOLE_CONTACT_TOLERANCE)
+        .map(|c| Point2::new(c.x, c.y))
+        .collect();
+    let com = center_of_mass(sim)?;
+    Ok(polygon_margin(Point2::new(com.x, com.y), &convex_hull(touching)))
+}
+
+/// Resets the robot to `posture` with the first sole flat on the ground: the base is
+/// placed so that this sole's frame keeps its x–y position and heading at the identity
+/// base, with no roll or pitch, and its lowest box corner `clearance` (m) above `ground`.
+pub fn reset_on_ground(sim: &mut World, posture: &[f64], sole: &str, ground: f64, clearance: f64) -> Result<()> {
+    check_finite("ground height and clearance", &[ground, clearance])?;
+    sim.reset_with_base(posture, &Isometry3::identity())?;
+    let sole_pose = sim.link_pose(sole)?;
+    let (_, _, yaw) = sole_pose.rotation.euler_angles();
+    let flat = Isometry3::from_parts(
+        Translation3::new(sole_pose.translation.x, sole_pose.translation.y, 0.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, yaw),
+    );
+    let base = flat * sole_pose.inverse();
+    sim.reset_with_base(posture, &base)?;
+    let lowest = box_corners(sim, &sim.model, sole)?
+        .iter()
+        .map(|c| c.z)
+        .fold(f64::INFINITY, f64::min);
+    if !lowest.is_finite() {
+        return Err(SimError::Input(CoreError::InvalidParameter {
+            name: "sole",
+            value: f64::NAN,
+            reason: "the sole link has no box collision shape",
+        }));
+    }
+    let lifted = Isometry3::translation(0.0, 0.0, ground + clearance - lowest) * base;
+    sim.reset_with_base(posture, &lifted)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn margin_of_a_square_is_the_distance_to_its_nearest_edge() {
+        let pts = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0), (0.5, 0.5)]
+            .iter()
+            .map(|&(x, y)| Point2::new(x, y))
+            .collect();
+        let hull = convex_hull(pts);
+        assert_eq!(hull.len(), 4);
+        assert!((polygon_margin(Point2::new(0.5, 0.2), &hull) - 0.2).abs() < 1e-12);
+        assert!((polygon_margin(Point2::new(0.5, -0.3), &hull) + 0.3).abs() < 1e-12);
+        assert!((polygon_margin(Point2::new(2.0, 0.5), &[hull[1], hull[2]]) + 1.0).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,167 @@
+//! The fall check (SPEC §4.3, paper Fig. 7a): drive a free-floating robot standing on the
+//! floor through a sequence of joint targets and report, per segment, whether it fell
+//! ([`crate::fall`]), its smallest support margin and its grip error (the distance between
+//! the two hand frames minus the object's width).
+
+use latent_core::CoreError;
+
+use crate::error::{Result, SimError, check_finite};
+use crate::fall::{FallCriteria, FallStatus, reset_on_ground, support_margin};
+use crate::task::{ConstraintKind, Task};
+use crate::world::World;
+
+/// What the fall check measures and for how long it holds each target.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FallCheckConfig {
+    /// Time each target of the sequence is held (s); rounded up to whole physics steps.
+    pub hold: f64,
+    /// The sole links (box collision shapes); their corners make the support polygon, the
+    /// first stands flat at the start.
+    pub soles: Vec<String>,
+    /// The two hand frames whose distance is the grip.
+    pub hands: [String; 2],
+    /// Width of the held object (m): the demonstrated hand distance. Default 0.10.
+    pub grip_width: f64,
+    /// The fall test. Default: sole tilt 20°, base height half its start value (set by
+    /// [`run_fall_check`] from the start posture when `min_base_height` is ≤ 0).
+    pub fall: FallCriteria,
+    /// Evaluate the fall test, margin and grip every this many physics steps. Default 4.
+    pub check_every: usize,
+}
+
+impl FallCheckConfig {
+    /// The check of a task with a fall rule (its soles and tilt) and a distance constraint
+    /// (its two links are the hands, its value the grip width), holding each target `hold` s.
+    pub fn for_task(task: &Task, hold: f64) -> Result<Self> {
+        let config = task.config();
+        let failed = |reason: &str| SimError::Task {
+            origin: task.origin().to_string(),
+            reason: reason.to_string(),
+        };
+        let rule = config
+            .fall
+            .as_ref()
+            .ok_or_else(|| failed("the fall check needs a [fall] table"))?;
+        let grip = config
+            .constraints
+            .iter()
+            .find(|c| c.kind == ConstraintKind::Distance)
+            .ok_or_else(|| failed("the fall check needs a distance constraint (the grip)"))?;
+        Ok(Self {
+            hold,
+            soles: rule.soles.clone(),
+            hands: [grip.links[0].clone(), grip.links[1].clone()],
+            grip_width: grip.value.unwrap_or(0.0),
+            fall: FallCriteria {
+                min_base_height: 0.0,
+                max_sole_tilt: rule.max_tilt,
+                soles: rule.soles.clone(),
+            },
+            check_every: 4,
+        })
+    }
+}
+
+/// What happened while one target of the sequence was held.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SegmentReport {
+    /// The robot met the fall test at some check of this segment (or an earlier one).
+    pub fell: bool,
+    /// Smallest support margin over the segment's checks (m; negative = outside).
+    pub min_margin: f64,
+    /// Support margin at the end of the segment (m).
+    pub final_margin: f64,
+    /// Hand distance minus the grip width at the end of the segment (m).
+    pub grip_error: f64,
+    /// Largest |hand distance − grip width| over the segment's checks (m).
+    pub max_grip_error: f64,
+    /// The fall status at the end of the segment.
+    pub status: FallStatus,
+    /// Time since the check's start (s) of the first check that met the fall test, in this
+    /// segment or an earlier one; `None` while the robot stands.
+    pub fall_time: Option<f64>,
+}
+
+/// The fall check: resets the robot at `start` standing on the ground, then holds each
+/// of `targets` for `config.hold` seconds, reporting one [`SegmentReport`] per target.
+///
+/// Once the robot has fallen every later segment reports `fell` too (it stays down).
+/// When `config.fall.min_base_height` is ≤ 0 it is set to half the base height at the
+/// start posture. Fails on wrong lengths, non-finite values, postures outside the joint
+/// limits (targets are clamped), unknown links or a non-positive hold.
+pub fn run_fall_check(
+    sim: &mut World,
+    start: &[f64],
+    targets: &[Vec<f64>],
+    config: &FallCheckConfig,
+) -> Result<Vec<SegmentReport>> {
+    run_fall_check_observed(sim, start, targets, config, |_, _| {})
+}
+
+/// [`run_fall_check`] that also calls `observe(sim, fell)` after the reset and after every
+/// check (every `config.check_every` physics steps; `sim.time()` is the time since the start),
+/// e.g. to record the robot's poses for a picture.
+pub fn run_fall_check_observed(
+    sim: &mut World,
+    start: &[f64],
+    targets: &[Vec<f64>],
+    config: &FallCheckConfig,
+    mut observe: impl FnMut(&World, bool),
+) -> Result<Vec<SegmentReport>> {
+    check_finite("hold", &[config.hold, config.grip_width])?;
+    if config.hold <= 0.0 || config.check_every == 0 {
+        return Err(SimError::Input(CoreError::InvalidParameter {
+            name: "hold",
+            value: config.hold,
+            reason: "hold must be > 0 and check_every ≥ 1",
+        }));
+    }
+    let ground = sim.config.floor.unwrap_or(0.0);
+    reset_on_ground(sim, start, &config.soles[0], ground, 5e-4)?;
+    let mut fall = config.fall.clone();
+    if fall.min_base_height <= 0.0 {
+        fall.min_base_height = ground + 0.5 * (sim.base_pose().translation.z - ground);
+    }
+    let hands = [
+        sim.frame(&config.hands[0], [0.0; 3])?,
+        sim.frame(&config.hands[1], [0.0; 3])?,
+    ];
+    let grip = |sim: &World| {
+        let (a, b) = (sim.frame_position(&hands[0]), sim.frame_position(&hands[1]));
+        let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+        d - config.grip_width
+    };
+    let steps = (config.hold / sim.config.physics.dt).ceil() as usize;
+    let mut fall_time = None;
+    let mut out = Vec::with_capacity(targets.len());
+    observe(sim, false);
+    for target in targets {
+        sim.set_targets(target)?;
+        let mut min_margin = f64::INFINITY;
+        let mut max_grip = 0.0_f64;
+        let mut done = 0;
+        while done < steps {
+            let n = config.check_every.min(steps - done);
+            sim.step(n);
+            done += n;
+            let margin = support_margin(sim, &config.soles)?;
+            min_margin = min_margin.min(margin);
+            max_grip = max_grip.max(grip(sim).abs());
+            if fall_time.is_none() && sim.fall_status(&fall)?.fell {
+                fall_time = Some(sim.time());
+            }
+            observe(sim, fall_time.is_some());
+        }
+        let status = sim.fall_status(&fall)?;
+        out.push(SegmentReport {
+            fell: fall_time.is_some(),
+            min_margin,
+            final_margin: support_margin(sim, &config.soles)?,
+            grip_error: grip(sim),
+            max_grip_error: max_grip,
+            status,
+            fall_time,
+        });
+    }
+    Ok(out)
+}

@@ -1,0 +1,84 @@
+"""`latentrl train`: a latent policy on any task from a demo file (or a saved GPLVM), run with
+the one runner (results layout of SPEC §5, resumable) and saved as `DIR/policy.npz`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from latentrl.demos import load_demos
+from latentrl.experiments.latent_runs import latent_setup
+from latentrl.experiments.presets import latent_box
+from latentrl.experiments.runner import Setup, finished_trials, load_arrays
+from latentrl.gplvm import GPLVM
+from latentrl.task import Task
+from latentrl.train import LatentPolicy, TrainPreset
+
+
+@dataclass(frozen=True)
+class TrainRun(TrainPreset):
+    """A training run of `latentrl train`: the preset, the task file, the demos and the model."""
+
+    task_file: str = ""
+    """The task file (TOML), as given."""
+    demos: str = ""
+    """The demonstrations (CSV with a header of joint names, NPZ or JSON), as given."""
+    model: str = ""
+    """A saved GPLVM to use instead of fitting one to the demos ("" = fit, d = 2)."""
+
+    def validate(self) -> None:
+        """ValueError naming the first impossible field, file, task key or demo column."""
+        super().validate()
+        if not self.task_file or not self.demos:
+            raise ValueError("a training run needs a task file and a demo file")
+        fitted(self)
+
+
+@lru_cache(maxsize=2)
+def _load(task_file: str, overrides: tuple[tuple[str, Any], ...], demos: str, model: str,
+          seed: int, max_iter: int) -> tuple[Task, np.ndarray, GPLVM]:
+    task = Task.load(task_file).replace(dict(overrides))
+    postures = load_demos(demos, min_postures=3)
+    task.check_joints(postures.joint_names, demos)
+    gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed)
+    if model:
+        if gplvm.n_features_in_ != len(task.joint_names):
+            raise ValueError(f"{model}: fitted to {gplvm.n_features_in_} joints, the task's robot has {len(task.joint_names)}")
+    else:
+        gplvm.fit(postures.postures)
+    return task, postures.postures, gplvm
+
+
+def fitted(run: TrainRun) -> tuple[Task, np.ndarray, GPLVM]:
+    """The task (with the run's overrides), the demo postures and the GPLVM (fitted or loaded);
+    cached, so validation and setup share the fit."""
+    overrides = tuple(sorted(run.task.items()))
+    return _load(run.task_file, overrides, run.demos, run.model, run.seed, run.gplvm_max_iter)
+
+
+def setup(run: TrainRun) -> Setup:
+    """The task's learner on the GPLVM's latent box."""
+    task, demos, model = fitted(run)
+    return latent_setup(run, task, model, latent_box(model.Z_, run.latent_margin), demos)
+
+
+def save_policy(run: TrainRun, out: Path) -> LatentPolicy:
+    """`out/policy.npz` from the finished trials of the run in `out`."""
+    task, demos, model = fitted(run)
+    arrays, done = finished_trials(load_arrays(out))
+    if not done:
+        raise ValueError(f"{out}: no finished trial, so no policy")
+    low, high = latent_box(model.Z_, run.latent_margin)
+    record = {what: arrays[f"latent{suffix}"] for what, suffix in (
+        ("returns", ""), ("ends", "_end"), ("reached", "_reached"))}
+    if "latent_test" in arrays:
+        record.update(test_returns=arrays["latent_test"], test_ends=arrays["latent_test_end"],
+                      test_reached=arrays["latent_test_reached"])
+    policy = LatentPolicy(task=task, model=model, demos=demos, latent_low=low, latent_high=high,
+                          weights=arrays["latent_weights"], preset=run, record=record)
+    policy.save(out / "policy.npz")
+    return policy

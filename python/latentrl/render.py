@@ -1,0 +1,83 @@
+"""Pictures of a task's robot from the native plant's link poses (`render_mode="rgb_array"`):
+the kinematic tree, the effectors' target, the obstacles and the floor, in the x–z side view
+of a floating robot or the x–y view of a fixed one; needs matplotlib (the `[plot]` extra)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl import _native
+from latentrl.task import Task
+
+
+def _canvas(size: int = 400) -> tuple[Any, Any]:
+    """A matplotlib Figure on an Agg canvas (no pyplot, no display) and its axes."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(size / 100, size / 100), dpi=100)
+    FigureCanvasAgg(fig)
+    return fig, fig.add_subplot(aspect="equal")
+
+
+def _pixels(fig: Any) -> NDArray[np.uint8]:
+    fig.canvas.draw()
+    return np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
+
+
+def view_axes(task: Task) -> tuple[int, int]:
+    """The world axes drawn: (x, z) for a floating robot, (x, y) for a fixed one."""
+    return (0, 2) if task.to_dict()["root"] == "floating" else (0, 1)
+
+
+def draw_task(task: Task, plant: _native.TaskPlant, size: int = 400) -> NDArray[np.uint8]:
+    """An RGB image (size, size, 3) of the task's robot as the plant holds it now."""
+    from matplotlib.patches import Rectangle
+
+    a, b = view_axes(task)
+    config = task.to_dict()
+    poses = np.asarray(plant.link_poses())
+    positions = {name: pose[:3] for name, pose in zip(task.link_names, poses) if np.all(np.isfinite(pose))}
+    target = np.asarray(config["target"]["position"], dtype=np.float64).reshape(-1, 3)
+    fig, ax = _canvas(size)
+    # The view: the robot and the target, with a margin (the obstacles may reach beyond it).
+    points = np.vstack([*positions.values(), target])[:, [a, b]]
+    low, high = points.min(axis=0), points.max(axis=0)
+    centre = (low + high) / 2
+    half = max(0.2, 0.6 * float((high - low).max()))
+    ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half))
+    for box in config["obstacles"]:
+        lo, hi = _corners(box)
+        ax.add_patch(Rectangle((lo[a], lo[b]), hi[a] - lo[a], hi[b] - lo[b], color="0.6"))
+    if config["floor"] is not None and b == 2:
+        ax.axhline(config["floor"]["height"], color="0.4", lw=2)
+    for parent, child in task.edges:
+        if parent in positions and child in positions:
+            p, c = positions[parent], positions[child]
+            ax.plot([p[a], c[a]], [p[b], c[b]], "o-", color="C0", lw=2, ms=3)
+    ax.plot(target[:, a], target[:, b], "g*", ms=10)
+    return _pixels(fig)
+
+
+def _corners(box: Mapping[str, Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Lower and upper corners of an obstacle table (min/max, or center/half_extents)."""
+    if box.get("min") is not None:
+        return np.asarray(box["min"]), np.asarray(box["max"])
+    c, h = np.asarray(box["center"]), np.asarray(box["half_extents"])
+    return c - h, c + h
+
+
+def draw_bimanual(config: Mapping[str, Any], hands: NDArray[np.float64], size: int = 400) -> NDArray[np.uint8]:
+    """An RGB image of Experiment 1's toy: the hands, the target and the disc obstacle."""
+    from matplotlib.patches import Circle
+
+    fig, ax = _canvas(size)
+    ax.set(xlim=(config["box_low"], config["box_high"]), ylim=(config["box_low"], config["box_high"]))
+    ax.add_patch(Circle(tuple(config["obstacle_centre"]), config["obstacle_radius"], color="0.6"))
+    ax.plot(*np.asarray(config["target"]).reshape(2, 2).T, "g*", ms=10)
+    ax.plot(*np.asarray(hands).reshape(2, 2).T, "o-", color="C0", lw=3)
+    return _pixels(fig)

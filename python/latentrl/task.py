@@ -1,0 +1,226 @@
+"""Tasks: a robot (URDF), its servos and physics, effectors with a target and a Gaussian reward,
+the rules that end an episode, the episodes and the learner, read from a TOML task file
+(docs/tasks.md) or built in Python. Every key, default and rule is the native side's
+(`crates/sim/src/task/config.rs`); this module loads, derives and names them.
+
+    task = Task.load("my_robot.toml")            # or Task.shipped("two_arms")
+    quick = task.replace({"learner.initial_weight": 100.0, "episode.max_steps": 200})
+    plant = quick.plant(demos)                    # the native plant: reset, step, classify
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Mapping
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl import _native
+
+SHIPPED = ("two_arms", "humanoid_lift")
+"""The task files shipped in `latentrl/tasks/`: Experiment 2's arms and Experiment 3's lift."""
+
+
+def shipped_path(name: str) -> Path:
+    """Path of the shipped task file `name` (one of `SHIPPED`)."""
+    if name not in SHIPPED:
+        raise ValueError(f"no shipped task {name!r}; shipped tasks: {', '.join(SHIPPED)}")
+    return Path(str(resources.files("latentrl") / "tasks" / f"{name}.toml"))
+
+
+@cache
+def schema() -> tuple[dict[str, Any], ...]:
+    """Every key of a task file: `{key, doc, rule, kind, default}` (the native definitions)."""
+    return tuple(_native.task_schema())
+
+
+def _plain(value: Any) -> Any:
+    """`value` with every tuple and list a fresh list and every dict a fresh dict."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    return value
+
+
+def _set(config: dict[str, Any], key: str, value: Any, origin: str) -> None:
+    """Sets the dotted `key` of a nested task dict (tables are created as needed)."""
+    *tables, last = key.split(".")
+    node = config
+    for i, table in enumerate(tables):
+        child = node.setdefault(table, {})
+        if child is None:
+            child = node[table] = {}
+        if not isinstance(child, dict):
+            raise ValueError(f"{origin}: {'.'.join(tables[: i + 1])} is not a table, so {key} cannot be set")
+        node = child
+    node[last] = value
+
+
+class Task:
+    """A checked task (a thin wrapper of the native `Task`): its configuration, its robot's joint
+    names and limits, its effectors; `plant()` builds the native plant that applies its rules."""
+
+    def __init__(self, native: _native.Task, base_dir: Path) -> None:
+        self._native = native
+        self.base_dir = base_dir
+        """The folder the task's URDF path is relative to (the task file's)."""
+
+    @classmethod
+    def load(cls, path: str | Path) -> Task:
+        """Reads a TOML task file; an error names the file, the key and the rule (ValueError)."""
+        path = Path(path)
+        return cls(_native.Task.load(path), path.parent)
+
+    @classmethod
+    def shipped(cls, name: str) -> Task:
+        """A task file shipped with latentrl (`SHIPPED`)."""
+        return cls.load(shipped_path(name))
+
+    @classmethod
+    def from_dict(cls, config: Mapping[str, Any], base_dir: str | Path = ".", origin: str = "<dict>") -> Task:
+        """A task from a dict of task-file keys (nested tables as dicts); the URDF path is
+        relative to `base_dir`."""
+        base = Path(base_dir)
+        return cls(_native.Task.from_dict(dict(config), base, origin), base)
+
+    def replace(self, overrides: Mapping[str, Any], origin: str | None = None) -> Task:
+        """This task with `overrides` (dotted keys: ``{"learner.alpha": 0.5}``) applied and checked."""
+        if not overrides:
+            return self
+        config = self.to_dict()
+        name = origin or f"{self.origin} with {', '.join(sorted(overrides))}"
+        for key, value in overrides.items():
+            _set(config, key, value, name)
+        return Task.from_dict(config, self.base_dir, name)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Every key with its effective value: a fresh nested dict of plain values (lists, not
+        tuples, so that it equals itself read back from JSON)."""
+        config: dict[str, Any] = _plain(self._native.to_dict())
+        return config
+
+    def digest(self) -> str:
+        """SHA-256 of the effective configuration and the URDF's text: what a saved policy
+        records, so that it is not run on another task."""
+        text = json.dumps(self.to_dict(), sort_keys=True, allow_nan=True)
+        urdf = self.urdf_path.read_bytes()
+        return hashlib.sha256(text.encode() + b"\0" + urdf).hexdigest()
+
+    def plant(self, demos: NDArray[np.float64] | None = None) -> _native.TaskPlant:
+        """The native plant of this task (home posture: demo `episode.start_demo` of `demos`)."""
+        rows = None if demos is None else np.ascontiguousarray(demos, dtype=np.float64)
+        return _native.TaskPlant(self._native, rows)
+
+    def check_joints(self, joint_names: tuple[str, ...] | list[str], where: str) -> None:
+        """ValueError naming `where` unless `joint_names` are this robot's actuated joints in order."""
+        expected = list(self.joint_names)
+        if list(joint_names) != expected:
+            missing = [j for j in expected if j not in joint_names]
+            extra = [j for j in joint_names if j not in expected]
+            detail = f"missing {missing}, not joints of the robot {extra}" if missing or extra else "in another order"
+            raise ValueError(f"{where}: the columns must be the actuated joints of {self.origin} in URDF order "
+                             f"{expected}; got {list(joint_names)} ({detail})")
+
+    @property
+    def urdf_path(self) -> Path:
+        """The robot's URDF file (the task's `urdf` key, relative to `base_dir`)."""
+        return self.base_dir / str(self.to_dict()["urdf"])
+
+    @property
+    def name(self) -> str:
+        """The task's name."""
+        return self._native.name
+
+    @property
+    def origin(self) -> str:
+        """Where the task came from (its file, or the name it was given)."""
+        return self._native.origin
+
+    @property
+    def joint_names(self) -> tuple[str, ...]:
+        """The robot's actuated joints, the columns of its postures (URDF order)."""
+        return tuple(self._native.joint_names)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """Every URDF link, in URDF order (the rows of `TaskPlant.link_poses`)."""
+        return tuple(self._native.link_names)
+
+    @property
+    def edges(self) -> list[tuple[str, str]]:
+        """(parent link, child link) of every joint: the kinematic tree, to draw it."""
+        return list(self._native.edges)
+
+    @property
+    def effectors(self) -> tuple[str, ...]:
+        """The effector links, whose positions the reward and the paths use."""
+        return tuple(self._native.effectors)
+
+    @property
+    def lower(self) -> NDArray[np.float64]:
+        """Lower joint limits."""
+        return np.asarray(self._native.lower)
+
+    @property
+    def upper(self) -> NDArray[np.float64]:
+        """Upper joint limits."""
+        return np.asarray(self._native.upper)
+
+    @property
+    def row_len(self) -> int:
+        """Columns of a recorded path row: 3 per effector, the base pose (7), the joints."""
+        return int(self._native.row_len)
+
+    @property
+    def rl_dt(self) -> float:
+        """Duration of one RL step (s)."""
+        return float(self._native.rl_dt)
+
+    def row_slices(self) -> dict[str, slice]:
+        """Where a recorded path row keeps the effectors (x, y, z each), the base position, the
+        base quaternion (x, y, z, w) and the joints."""
+        e = 3 * len(self.effectors)
+        return {
+            "effectors": slice(0, e),
+            "base_position": slice(e, e + 3),
+            "base_quaternion": slice(e + 3, e + 7),
+            "joints": slice(e + 7, e + 7 + len(self.joint_names)),
+        }
+
+    def __repr__(self) -> str:
+        return f"Task({self.name!r}, {self.origin!r}, {len(self.joint_names)} joints, effectors {list(self.effectors)})"
+
+
+def schema_markdown() -> str:
+    """The keys of a task file as Markdown tables, one per table (docs/tasks.md embeds it)."""
+    sections: dict[str, list[dict[str, Any]]] = {}
+    for entry in schema():
+        table = entry["key"].rpartition(".")[0]
+        sections.setdefault(table, []).append(entry)
+    out = []
+    for table, entries in sections.items():
+        out.append(f"### `[{table}]`" if table else "### top level")
+        out.append("")
+        out.append("| key | type | default | rule | meaning |")
+        out.append("|---|---|---|---|---|")
+        for e in entries:
+            name = e["key"].rpartition(".")[2]
+            rule = "" if e["rule"] == "any value" else e["rule"]
+            table_kind = "table" in e["kind"]
+            default = "(below)" if table_kind else f"`{json.dumps(e['default'], allow_nan=True)}`"
+            cells = [f"`{name}`", e["kind"], default, rule, e["doc"]]
+            out.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+        out.append("")
+    return "\n".join(out)
+
+
+def end_reasons() -> tuple[str, ...]:
+    """How an episode ended, by code (`returns.npz`'s `<learner>_end`; −1: not run)."""
+    return tuple(_native.end_reasons())
