@@ -113,6 +113,11 @@ def test_results_layout_follows_spec(quick_run):
         assert npz["latent_test"].shape == (preset.trials, preset.test_episodes)
         assert npz["latent_weights"].shape == (preset.trials, 20**2)
         assert npz["latent_test_paths"].shape[-1] == 6 + 7 + 19
+        # Both hands at the start of every frozen test: the first row of each recorded test path.
+        starts = npz["latent_test_start_hands"]
+        assert starts.shape == (preset.trials, preset.test_episodes, 6) and np.isfinite(starts).all()
+        recorded = npz["latent_test_paths"].shape[1]
+        np.testing.assert_array_equal(starts[:, :recorded], npz["latent_test_paths"][:, :, 0, :6])
     for fig in ("fig7b", "fig7c", "fig7d", "fig7e", "fig8"):
         for ext in ("png", "pdf"):
             assert (out / f"{fig}.{ext}").stat().st_size > 1000

@@ -253,13 +253,12 @@ def _rollout(args: argparse.Namespace) -> int:
     policy = LatentPolicy.load(path)
     if args.episodes < 1:
         raise ValueError(f"--episodes must be at least 1, got {args.episodes}")
-    from tqdm import tqdm
+    from latentrl.progress import progress_bar
 
-    with tqdm(unit="ep", desc="rollout", disable=not args.progress) as bar:
+    with progress_bar(unit="ep", desc="rollout", disable=not args.progress) as bar:
         def report(done: int, total: int) -> None:
             bar.total = total
-            bar.n = done
-            bar.refresh()
+            bar.update(done - bar.n)
 
         result = policy.rollout(args.episodes, trial=args.trial, seed=args.seed, progress=report)
     args.out.mkdir(parents=True, exist_ok=True)

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from tqdm import tqdm
+from latentrl.progress import progress_bar
 
 from latentrl import _native
 from latentrl._base import FORMAT_VERSION, PathLike, atomic_write, read_npz
@@ -115,7 +115,7 @@ def train_latent_policy(
         task, model, (low, high), starts, episodes=chosen.episodes, seed=chosen.seed, test_episodes=chosen.test_episodes
     )
     built = Setup(learners={"latent": learner})
-    with tqdm(total=chosen.trials * episodes_per_trial(chosen), unit="ep", desc="episodes", disable=not progress) as bar:
+    with progress_bar(total=chosen.trials * episodes_per_trial(chosen), unit="ep", desc="episodes", disable=not progress) as bar:
         *_, result = next(iter(run_in_process(built, [("latent", 0, chosen.trials)], bar.update)))
     return LatentPolicy(
         task=task, model=model, demos=starts, latent_low=low, latent_high=high, weights=np.asarray(result["weights"]),

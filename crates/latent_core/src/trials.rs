@@ -135,6 +135,9 @@ pub struct TrialResult {
     pub tests: Vec<EpisodeRecord>,
     /// One task-space trajectory per entry of `record_test_episodes`, as `trajectories`.
     pub test_trajectories: Vec<Vec<f64>>,
+    /// The task-space row at the start of every test episode run, concatenated (`task_dim`
+    /// values each): where each frozen test started (e.g. the hands at floor level or not).
+    pub test_starts: Vec<f64>,
 }
 
 /// Runs `options.n_trials` trials in parallel (rayon's current pool). Each trial clones
@@ -239,11 +242,16 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
         cancel,
         done,
     };
-    let (episodes, trajectories, mut finished) = run.block(options.episodes, &options.record_episodes)?;
+    let (episodes, trajectories, mut finished) = run.block(options.episodes, &options.record_episodes, None)?;
     let (mut tests, mut test_trajectories) = (Vec::new(), vec![Vec::new(); options.record_test_episodes.len()]);
+    let mut test_starts = Vec::new();
     if finished && options.test_episodes > 0 {
         run.learner.set_phase(Phase::Test);
-        (tests, test_trajectories, finished) = run.block(options.test_episodes, &options.record_test_episodes)?;
+        (tests, test_trajectories, finished) = run.block(
+            options.test_episodes,
+            &options.record_test_episodes,
+            Some(&mut test_starts),
+        )?;
     }
     let weights = options.keep_weights.then(|| run.learner.into_weights());
     Ok(TrialResult {
@@ -254,6 +262,7 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
         weights,
         tests,
         test_trajectories,
+        test_starts,
     })
 }
 
@@ -270,24 +279,33 @@ struct TrialRun<'a, P> {
 
 impl<P: Plant> TrialRun<'_, P> {
     /// Runs `n` episodes in the learner's current phase, recording the trajectories of the
-    /// episodes listed in `record`; returns the records, the trajectories and whether the
-    /// block finished (false if cancelled).
-    fn block(&mut self, n: usize, record: &[usize]) -> Result<(Vec<EpisodeRecord>, Vec<Vec<f64>>, bool)> {
+    /// episodes listed in `record` (and, with `starts`, the first row of every episode);
+    /// returns the records, the trajectories and whether the block finished (false if cancelled).
+    fn block(
+        &mut self,
+        n: usize,
+        record: &[usize],
+        mut starts: Option<&mut Vec<f64>>,
+    ) -> Result<(Vec<EpisodeRecord>, Vec<Vec<f64>>, bool)> {
         let mut episodes = Vec::with_capacity(n);
         let mut trajectories = vec![Vec::new(); record.len()];
         let mut buffer = Vec::new();
+        let task_dim = self.plant.task_dim();
         for e in 0..n {
             if self.cancel.load(Ordering::Relaxed) {
                 return Ok((episodes, trajectories, false));
             }
             let (plant, rng, space, scratch) = (&mut self.plant, &mut self.rng, self.space, &mut self.scratch);
-            let rec = if record.contains(&e) {
+            let rec = if starts.is_some() || record.contains(&e) {
                 buffer.clear();
                 self.learner
                     .run_episode(plant, space, rng, scratch, Some(&mut buffer))?
             } else {
                 self.learner.run_episode(plant, space, rng, scratch, None)?
             };
+            if let Some(starts) = starts.as_deref_mut() {
+                starts.extend_from_slice(&buffer[..task_dim]);
+            }
             // The same episode may be listed twice: every listed slot gets the trajectory.
             for (slot, r) in trajectories.iter_mut().zip(record) {
                 if *r == e {

@@ -312,6 +312,16 @@ pub(crate) fn pack_results<'py>(
     paths("test_trajectories", options.record_test_episodes.len(), |r| {
         &r.test_trajectories
     })?;
+    let mut starts = vec![f64::NAN; results.len() * options.test_episodes * task_dim];
+    for (i, r) in results.iter().enumerate() {
+        let at = i * options.test_episodes * task_dim;
+        let len = r.test_starts.len().min(options.test_episodes * task_dim);
+        starts[at..at + len].copy_from_slice(&r.test_starts[..len]);
+    }
+    out.set_item(
+        "test_starts",
+        PyArray1::from_vec(py, starts).reshape([results.len(), options.test_episodes, task_dim])?,
+    )?;
     out.set_item(
         "finished",
         PyArray1::from_vec(py, results.iter().map(|r| r.finished).collect::<Vec<bool>>()),

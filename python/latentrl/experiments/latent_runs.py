@@ -51,10 +51,10 @@ def task_learner(
     test_episodes: int = 0,
 ) -> RunTrials:
     """`_native.run_task_trials` on `task`, decoding and encoding with `model` in the latent
-    `box` (low, high), starting "demo" episodes from `demos`, with the recorded episodes and the
-    final weights."""
+    `box` (low, high), starting "demo" episodes from `demos`, with the recorded episodes, the
+    effectors at every test start (`test_start_hands`) and the final weights."""
     low, high = box
-    return partial(
+    run = partial(
         _native.run_task_trials,
         task._native,
         decoder=model.decoder_,
@@ -69,6 +69,15 @@ def task_learner(
         record_test_episodes=recorded_tests(test_episodes),
         return_weights=True,
     )
+    effectors = task.row_slices()["effectors"]
+
+    def with_start_hands(**kwargs: Any) -> dict[str, Any]:
+        """The native result plus `test_start_hands`: the effectors of every test start."""
+        out = run(**kwargs)
+        out["test_start_hands"] = out.pop("test_starts")[..., effectors]
+        return out
+
+    return with_start_hands
 
 
 def latent_setup(

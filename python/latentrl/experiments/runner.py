@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
-from tqdm import tqdm
+from latentrl.progress import progress_bar
 
 from latentrl._base import read_npz
 from latentrl.task import end_reasons
@@ -52,11 +52,13 @@ PER_TRIAL = {
     "test_passed": "_test_passed",
     "trajectories": "_paths",
     "test_trajectories": "_test_paths",
+    "test_start_hands": "_test_start_hands",
     "weights": "_weights",
 }
 """Further per-trial arrays of the native call (frozen test episodes (trials, K), recorded
-paths, final weights) and their suffix in returns.npz; stored when the call returns them
-with a non-empty per-trial part."""
+paths, the effectors' (x, y, z) at the start of every test episode (trials, K, 3E), final
+weights) and their suffix in returns.npz; stored when the call returns them with a non-empty
+per-trial part."""
 
 
 def array_key(learner: str, what: str) -> str:
@@ -150,7 +152,7 @@ def run_rl(
         for t in range(preset.trials)
         if arrays[array_key(name, "ends")][t, 0] < 0
     ]
-    bar = tqdm(total=len(todo) * episodes_per_trial(preset), unit="ep", disable=not progress, desc="episodes")
+    bar = progress_bar(total=len(todo) * episodes_per_trial(preset), unit="ep", disable=not progress, desc="episodes")
     meta.setdefault("trials", {})
     try:
         for name, first, n, result in execute(built, _chunks(todo, chunk), bar.update):

@@ -29,7 +29,7 @@ from pathlib import Path
 from dataclasses import dataclass
 from typing import Any, ClassVar, Protocol
 
-from tqdm import tqdm
+from latentrl.progress import progress_bar
 
 from latentrl.experiments.presets import describe
 from latentrl.experiments.ray_backend import RayBackend
@@ -148,7 +148,7 @@ def run_sweep(
 
     save_state()
     started = time.perf_counter()
-    bar = tqdm(total=sum(wanted.values()), initial=sum(done.values()), unit="trial",
+    bar = progress_bar(total=sum(wanted.values()), initial=sum(done.values()), unit="trial",
                desc=f"sweep {sweep.experiment} ({runner.name})", disable=not progress)
     try:
         failures.update(runner.run(jobs, bar.update, finished))

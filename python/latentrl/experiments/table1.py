@@ -500,8 +500,6 @@ class _NoBar:
 def _progress(total: int, enabled: bool) -> Any:
     if not enabled:
         return _NoBar()
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover - tqdm is a dependency
-        return _NoBar()
-    return tqdm(total=total, desc="Table I trials", unit="trial")
+    from latentrl.progress import progress_bar
+
+    return progress_bar(total=total, desc="Table I trials", unit="trial")
