@@ -9,6 +9,7 @@ in the same directory is an error.
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
@@ -140,6 +141,9 @@ def run_rl(
     arrays, meta = _previous(meta_path, arrays_path, plan)
     started = time.perf_counter()
     built = setup(preset)
+    if meta is not None:
+        _check_same_fit(meta, built, arrays, out)
+    arrays[PRESET_KEY] = np.array(json.dumps(plan, sort_keys=True, default=str))
     chunk = chunk or worker_threads()
     if meta is None:
         meta = {"preset": plan, "environment": environment(), "setup": built.info, "wall_time_s": 0.0}
@@ -254,7 +258,47 @@ def _previous(
         )
     if not arrays_path.exists():
         return {}, None
-    return load_arrays(arrays_path.parent), meta
+    arrays = load_arrays(arrays_path.parent)
+    _check_saved_run(meta_path.parent, plan, arrays)
+    return arrays, meta
+
+
+PRESET_KEY = "preset_json"
+"""Key in returns.npz of the preset the arrays were computed with (JSON): `--resume` refuses a
+results.json whose preset was edited since."""
+
+
+def _check_saved_run(out: Path, plan: dict[str, Any], arrays: Mapping[str, np.ndarray]) -> None:
+    """The arrays of a run being continued were computed with `plan`; a ValueError naming the
+    edited fields otherwise (mixing would be silently wrong)."""
+    if PRESET_KEY in arrays:
+        saved = json.loads(str(arrays[PRESET_KEY]))
+        edited = sorted(k for k in set(saved) | set(plan) if saved.get(k) != json.loads(json.dumps(plan.get(k), default=str)))
+        if edited:
+            changes = ", ".join(f"{k}: {saved.get(k)!r} in returns.npz, {plan.get(k)!r} in results.json" for k in edited)
+            raise ValueError(f"{out}/results.json was edited after its trials ran ({changes}); resume refuses to mix "
+                             "the two: restore the file, or start a new run with --out")
+
+
+def _check_same_fit(meta: Mapping[str, Any], built: Setup, arrays: Mapping[str, np.ndarray], out: Path) -> None:
+    """A continued run's per-episode arrays have the preset's shapes, and its model fit (the
+    GPLVM's objective and hyper-parameters) is the saved one: another seed, BLAS or CPU could
+    give another latent space, and mixing trials of two would be silently wrong."""
+    want = (meta["preset"]["trials"], meta["preset"]["episodes"])
+    for name in built.learners:
+        for what in PER_EPISODE:
+            key = array_key(name, what)
+            if key in arrays and arrays[key].shape != want:
+                raise ValueError(f"{out}/returns.npz: {key} has shape {arrays[key].shape}, the preset asks for "
+                                 f"{want} (trials, episodes); it belongs to another run")
+    saved, now = meta.get("setup", {}).get("gplvm"), built.info.get("gplvm")
+    if saved is not None and now is not None:
+        now_plain = json.loads(json.dumps(now, default=lambda v: np.asarray(v).tolist()))
+        if saved != now_plain:
+            raise ValueError(
+                f"{out}: the GPLVM fitted now (nll {now_plain.get('nll')}) is not the one the saved trials used "
+                f"(nll {saved.get('nll')}): an edited seed, or another machine's BLAS; resume refuses to mix them"
+            )
 
 
 def load_arrays(out_dir: Path | str) -> dict[str, np.ndarray]:

@@ -1,0 +1,72 @@
+"""Hostile inputs (issue #21), one regression test per class of the issue where it is fixed:
+edited runs (class 4) and values that reached a panic (class 5)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from latentrl import cli
+from latentrl._native import InvalidInputError, Sim
+
+TINY = ["run", "exp1", "--quick", "--trials", "2", "--episodes", "5", "--plant.max-steps", "20", "--no-progress"]
+
+
+@pytest.fixture()
+def finished_run(tmp_path):
+    out = tmp_path / "run"
+    assert cli.main([*TINY, "--out", str(out)]) == 0
+    return out
+
+
+def edit(out, change):
+    meta = json.loads((out / "results.json").read_text())
+    change(meta)
+    (out / "results.json").write_text(json.dumps(meta))
+
+
+@pytest.mark.parametrize(
+    ("change", "says"),
+    [
+        (lambda m: m["preset"].update(seed=7), "seed: 0 in returns.npz, 7 in results.json"),
+        (lambda m: m["preset"]["task"].update({"learner.alpha": 0.5}), "task: "),
+        (lambda m: m["preset"].update(trials=3), "trials: 2 in returns.npz, 3 in results.json"),
+    ],
+    ids=["seed", "a task key", "trials"],
+)
+def test_class_4_resume_refuses_an_edited_preset(finished_run, capsys, change, says):
+    before = (finished_run / "returns.npz").read_bytes()
+    edit(finished_run, change)
+    assert cli.main(["run", "exp1", "--resume", str(finished_run), "--no-progress"]) == 1
+    err = capsys.readouterr().err
+    assert "was edited after its trials ran" in err and says in err, err
+    assert (finished_run / "returns.npz").read_bytes() == before, "nothing is rewritten"
+
+
+def test_class_4_resume_refuses_another_model_fit(finished_run, capsys):
+    edit(finished_run, lambda m: m["setup"]["gplvm"].update(nll=m["setup"]["gplvm"]["nll"] + 1.0))
+    assert cli.main(["run", "exp1", "--resume", str(finished_run), "--no-progress"]) == 1
+    assert "is not the one the saved trials used" in capsys.readouterr().err
+
+
+def test_class_4_an_unedited_run_resumes(finished_run):
+    with np.load(finished_run / "returns.npz") as npz:
+        before = {k: npz[k] for k in npz.files}
+    assert cli.main(["run", "exp1", "--resume", str(finished_run), "--no-progress"]) == 0
+    with np.load(finished_run / "returns.npz") as npz:
+        for key, value in before.items():
+            np.testing.assert_array_equal(npz[key], value, err_msg=key)
+
+
+ONE_LINK = '<robot name="r"><link name="a"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+JOINT = '<joint name="{name}" type="revolute"><parent link="{parent}"/><child link="{child}"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>'
+
+
+def test_class_5_a_huge_physics_step_is_refused_before_any_step():
+    with pytest.raises(InvalidInputError, match=r"physics.dt must lie in \(0, 0.05\], got 10000000000"):
+        Sim(ONE_LINK + "</robot>", physics={"dt": 1e10})
+
+
+def test_class_5_a_joint_whose_parent_is_its_child_is_refused():
+    with pytest.raises(InvalidInputError, match="malformed URDF"):
+        Sim(ONE_LINK + JOINT.format(name="k", parent="a", child="a") + "</robot>")
