@@ -172,7 +172,7 @@ def test_load_rejects_bad_files(tmp_path, model):
     with pytest.raises(ValueError, match=r"holds latentrl\.PCA, expected latentrl\.GPLVM"):
         GPLVM.load(tmp_path / "pca.npz")
     mutations = [
-        ({"format_version": np.array(FORMAT_VERSION + 1)}, "format version 2 is not supported"),
+        ({"format_version": np.array(FORMAT_VERSION + 1)}, "format_version 2 \\(int64\\) is not supported"),
         ({"Z_": None}, "missing fitted attribute 'Z_'"),
         ({"Z_": model.Z_[:-1]}, "Z_: axis N has size 39, expected 40"),
         ({"theta_": np.ones(4)}, "theta_: axis 3 has size 4"),

@@ -1,5 +1,5 @@
 """Hostile inputs (issue #21), one regression test per class of the issue where it is fixed:
-edited runs (class 4) and values that reached a panic (class 5)."""
+edited runs (class 4), values that reached a panic (class 5), misleading messages (class 7)."""
 
 import json
 
@@ -70,3 +70,40 @@ def test_class_5_a_huge_physics_step_is_refused_before_any_step():
 def test_class_5_a_joint_whose_parent_is_its_child_is_refused():
     with pytest.raises(InvalidInputError, match="malformed URDF"):
         Sim(ONE_LINK + JOINT.format(name="k", parent="a", child="a") + "</robot>")
+
+
+def test_class_7_identical_postures_say_so(tmp_path):
+    from latentrl import GPLVM
+
+    with pytest.raises(ValueError, match="all 10 postures are identical"):
+        GPLVM(max_iter=5).fit(np.ones((10, 4)))
+
+
+def test_class_7_a_model_out_that_is_not_npz_is_refused_before_the_fit(tmp_path, capsys):
+    demos = tmp_path / "demos.csv"
+    demos.write_text("a,b\n" + "\n".join(f"{i},{i * i}" for i in range(10)) + "\n")
+    assert cli.main(["fit", str(demos), "--out", str(tmp_path / "model.json")]) == 1
+    assert "give a file name ending in .npz" in capsys.readouterr().err
+    assert not (tmp_path / "model.json").exists()
+
+
+def test_class_7_loading_a_json_file_as_a_model_gives_no_pickle_advice(tmp_path):
+    from latentrl import GPLVM
+
+    (tmp_path / "m.json").write_text('{"a": 1}')
+    with pytest.raises(ValueError, match="no zip archive header") as caught:
+        GPLVM.load(tmp_path / "m.json")
+    assert "pickle" not in str(caught.value)
+
+
+def test_class_7_a_string_format_version_is_named_as_such(tmp_path):
+    from latentrl import PCA
+
+    good = tmp_path / "good.npz"
+    PCA(n_components=1).fit(np.random.default_rng(0).normal(size=(5, 3))).save(good)
+    with np.load(good) as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    arrays["format_version"] = np.array("1")
+    np.savez(tmp_path / "edited.npz", **arrays)
+    with pytest.raises(ValueError, match=r"format_version '1' \(<U1\) is not supported \(this latentrl reads the integer 1\)"):
+        PCA.load(tmp_path / "edited.npz")

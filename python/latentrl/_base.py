@@ -60,6 +60,12 @@ def read_npz(path: PathLike) -> dict[str, NDArray[Any]]:
     """Every array of the NPZ file at `path`, read eagerly without pickles; a file that
     is not a readable NPZ is a ValueError."""
     with open(path, "rb") as fh:
+        magic = fh.read(6)
+        if magic.startswith(b"\x93NUMPY"):
+            raise ValueError("not a readable NPZ file: it holds a single array (.npy), not an NPZ archive")
+        if not magic.startswith(b"PK\x03\x04"):
+            raise ValueError("not a readable NPZ file: it has no zip archive header (latentrl writes models and results as .npz)")
+        fh.seek(0)
         try:
             npz = np.load(fh, allow_pickle=False)
             if not isinstance(npz, np.lib.npyio.NpzFile):
@@ -307,7 +313,10 @@ class Estimator:
             self._restore(state["fitted"])
 
     def save(self, path: PathLike) -> None:
-        """Writes the parameters and fitted state to an NPZ file at `path` (atomically)."""
+        """Writes the parameters and fitted state to an NPZ file at `path` (atomically; the name
+        must end in .npz, the format it holds)."""
+        if not str(path).endswith(".npz"):
+            raise ValueError(f"{path}: a model is saved as NPZ; give a file name ending in .npz")
         arrays = self._arrays()
         atomic_write(path, lambda fh: np.savez(fh, **arrays))
 
@@ -354,9 +363,10 @@ class Estimator:
             or version.dtype.kind != "i"
             or int(version) != FORMAT_VERSION
         ):
+            shown = "missing" if version is None else f"{version.tolist()!r} ({version.dtype})"
             raise ValueError(
-                f"{path}: format version {version} is not supported "
-                f"(this latentrl reads {FORMAT_VERSION})"
+                f"{path}: format_version {shown} is not supported "
+                f"(this latentrl reads the integer {FORMAT_VERSION})"
             )
         try:
             estimator = cls(**json.loads(str(arrays["params"])))

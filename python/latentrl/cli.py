@@ -275,6 +275,8 @@ def _rollout(args: argparse.Namespace) -> int:
 def _fit(args: argparse.Namespace) -> int:
     from latentrl import GPLVM, PCA, load_demos
 
+    if args.out.suffix != ".npz":
+        raise ValueError(f"--out {args.out}: a model is saved as NPZ; give a file name ending in .npz")
     demos = load_demos(args.demos, min_postures=args.n_components + 1)
     if args.model == "pca":
         model: Any = PCA(n_components=args.n_components)

@@ -145,6 +145,8 @@ class GPLVM(Estimator):
         names = column_names(X)
         X = as_matrix("X", X)
         check_n_components(self.n_components, X)
+        if not np.ptp(X, axis=0).any():
+            raise ValueError(f"X: all {len(X)} postures are identical; a GPLVM needs postures that differ")
         max_iter = int_at_least("max_iter", self.max_iter, 1)
         n_restarts = int_at_least("n_restarts", self.n_restarts, 0)
         noise_floor = positive("noise_floor", self.noise_floor)
