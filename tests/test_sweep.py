@@ -8,11 +8,11 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from child import CHILD, wait_for
 
 from latentrl.cli import main
 from latentrl.experiments.exp1 import Exp1Preset
@@ -302,14 +302,12 @@ def test_cli_errors_exit_1_with_the_message(tmp_path, capsys):
 
 def test_cli_sweep_stopped_by_ctrl_c_exits_130_and_resumes(local_run, tmp_path):
     path, out = write(tmp_path, SWEEP_TOML), tmp_path / "out"
-    child = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
-             "from latentrl.cli import main; sys.exit(main(sys.argv[1:]))")
+    held = tmp_path / "held"
     args = ["sweep", str(path), "--no-progress", "--out", str(out)]
-    proc = subprocess.Popen([sys.executable, "-c", child, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env={**os.environ, "RAYON_NUM_THREADS": "1"})
-    deadline = time.monotonic() + 120
-    while not (out / "00_learner.beta=5.0" / "returns.npz").exists() and time.monotonic() < deadline:
-        time.sleep(0.05)
+    env = {**os.environ, "RAYON_NUM_THREADS": "1", "LATENTRL_TEST_HOLD_AFTER_SAVE": str(held)}
+    proc = subprocess.Popen([sys.executable, "-c", CHILD, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=env)
+    wait_for(held, proc)  # the child holds after the first cell's first saved trial
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
