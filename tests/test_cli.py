@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from latentrl import __version__ as latentrl_version
 from latentrl.cli import build_parser, main
 
 from child import CHILD, wait_for
@@ -23,11 +24,19 @@ def latentrl(*args, timeout=300):
     )
 
 
-def test_info_prints_versions_as_json():
+def test_info_prints_versions_git_revision_and_threads_as_json():
+    """What the README promises of `latentrl info`: versions, git revision, thread count."""
     result = latentrl("info")
     assert result.returncode == 0, result.stderr
     info = json.loads(result.stdout)
-    assert info["versions"]["latentrl"] and info["cpu_count"] >= 1
+    assert info["versions"]["latentrl"] == latentrl_version and info["versions"]["numpy"] == np.__version__
+    revision = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True,
+                              cwd=Path(__file__).parent).stdout.strip()
+    assert info["git_revision"] == (revision or None)
+    assert info["cpu_count"] >= 1 and info["rayon_threads"] >= 1
+    env = {**os.environ, "RAYON_NUM_THREADS": "1"}
+    one = subprocess.run([sys.executable, "-m", "latentrl", "info"], capture_output=True, text=True, env=env)
+    assert json.loads(one.stdout)["rayon_threads"] == 1
 
 
 def test_help_documents_every_preset_flag():
@@ -67,8 +76,11 @@ def test_run_table1_tiny(tmp_path):
     assert (tmp_path / "table1.md").exists()
 
 
-def test_bad_values_exit_1_with_a_message(tmp_path):
+def test_bad_values_exit_1_with_a_message(tmp_path, capsys):
     assert main(["run", "exp1", "--quick", "--no-progress", "--trials", "0", "--out", str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("latentrl: error:") and "trials" in err and "got 0" in err, err
+    assert not any(tmp_path.iterdir()), "nothing is written for a bad value"
 
 
 def test_unknown_flag_exits_2():
@@ -87,7 +99,8 @@ def test_examples_run_quick(script, tmp_path):
         capture_output=True, text=True, timeout=600,
     )
     assert result.returncode == 0, result.stderr
-    assert any(tmp_path.iterdir())
+    figure = {"table1.py": "table1.md", "exp1.py": "fig4a.png", "exp2.py": "fig6a.png"}[script]
+    assert any(p.name == figure and p.stat().st_size > 0 for p in tmp_path.rglob("*")), sorted(tmp_path.rglob("*"))
 
 
 # Small runs of each experiment; RL trials long enough (~1-3 s each) to be caught mid-way.

@@ -57,7 +57,9 @@ def test_results_layout_follows_spec(quick_run):
     assert saved["preset"] == {"name": "Exp1Preset", **dataclasses.asdict(preset)}
     assert saved["environment"]["versions"]["numpy"] == np.__version__
     assert saved["wall_time_s"] > 0 and set(saved["trials"]) == {"latent", "full"}
-    # Peak resident memory is recorded; the bound for a full run is 2 GiB.
+    # Peak resident memory is recorded. It is the whole process's peak (here pytest's, after
+    # whatever ran before), so the bound is loose: the 2 GiB a full run may use. The README's
+    # 134 MiB is a separate process's full run (benches/bench_runs.json).
     assert 10 < saved["peak_rss_mib"] < 2048
     with np.load(out / "returns.npz") as npz:
         for name in ("latent", "full"):

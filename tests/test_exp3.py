@@ -75,7 +75,9 @@ def test_quick_preset_ends_episodes_correctly(quick_run):
     assert np.all((steps[ends != 0] >= 1) & (steps[ends != 0] <= max_steps))
     assert np.all(returns <= steps) and np.all(returns >= -1.0)
     assert np.all(returns[ends != 0] <= steps[ends != 0] - 1.0 + 1e-9), "penalty on terminal steps"
-    assert (ends == 0).mean() >= 0.3, "most starts hold the object without falling"
+    # Measured 61-71 % per trial (Intel, seed 0): a floor well below, for episodes that neither
+    # fall, drop nor touch the block; a plant that ended episodes at random would miss it.
+    assert (ends == 0).mean() >= 0.4, "fewer than 40 % of episodes ran to the time-out"
     for t, summary in meta["trials"]["latent"].items():
         assert sum(summary["ends"].values()) == preset.episodes
 

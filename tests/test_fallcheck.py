@@ -131,6 +131,14 @@ def test_pca_misses_the_demos_by_degrees(table):
     assert np.isfinite([r["sim_margin"] for r in pca]).all()  # falls: reported, not asserted
 
 
+def test_pca_falls_holding_the_top_pose_and_the_gplvm_stands():
+    """The README's fall-check claim, without matplotlib, on the default preset (PCA falls after
+    1.03 s, so the shortened holds of `table` would not see it): PCA's reconstruction of pose 6
+    (the top of the squat) falls, the GPLVM's stands."""
+    rows = {r["method"]: r for r in run_fallcheck() if r["segment"] == "pose 6"}
+    assert rows["PCA"]["fell"] and not rows["GPLVM"]["fell"], rows
+
+
 def test_fig7a_frames_agree_with_the_table(tmp_path):
     pytest.importorskip("matplotlib")
     from latentrl.experiments.fallcheck_figures import fallcheck_frames

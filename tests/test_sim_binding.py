@@ -118,9 +118,9 @@ def test_bad_inputs_raise_clear_errors(sim):
         Sim(urdf(ARMS), servo={"gain": 1.0})
     with pytest.raises(TypeError, match="dt"):  # the world's keys are in physics= and servo=
         Sim(urdf(ARMS), dt=0.01)  # type: ignore[call-arg]
-    with pytest.raises(InvalidInputError):
+    with pytest.raises(InvalidInputError, match="cannot read URDF file /no/such/robot.urdf: No such file"):
         Sim("/no/such/robot.urdf")
-    with pytest.raises(InvalidInputError):
+    with pytest.raises(InvalidInputError, match=r"malformed URDF \(<string>\)"):
         Sim("<robot name='broken'>")
 
 
