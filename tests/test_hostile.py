@@ -107,3 +107,25 @@ def test_class_7_a_string_format_version_is_named_as_such(tmp_path):
     np.savez(tmp_path / "edited.npz", **arrays)
     with pytest.raises(ValueError, match=r"format_version '1' \(<U1\) is not supported \(this latentrl reads the integer 1\)"):
         PCA.load(tmp_path / "edited.npz")
+
+
+def test_class_1_a_gp_too_large_to_hold_is_refused_before_allocating():
+    """60 000 points asked for a 28.8 GB kernel matrix and aborted the interpreter."""
+    from latentrl import GPLVM, GpMap, _native
+    from latentrl._native import gplvm_nll_grad
+
+    n = _native.MAX_GP_POINTS + 1
+    with pytest.raises(InvalidInputError, match=rf"inputs: {n} points need a {n}×{n} kernel matrix \(2.0 GiB\); the limit is"):
+        GpMap(np.zeros((n, 2)), np.zeros((n, 1)), np.ones(3))
+    with pytest.raises(InvalidInputError, match="latent points: 60000 points need"):
+        gplvm_nll_grad(np.zeros((60000, 2)), np.zeros((60000, 3)), np.zeros(3))
+    with pytest.raises(ValueError, match=rf"X: {n} postures, more than the {n - 1} a GPLVM fit takes"):
+        GPLVM().fit(np.random.default_rng(0).normal(size=(n, 3)))
+
+
+def test_class_3_a_run_too_long_to_hold_is_refused_before_allocating(tmp_path, capsys):
+    """--episodes 1e12 allocated 21.8 TiB of per-episode arrays before any check."""
+    assert cli.main([*TINY, "--episodes", "1000000000000", "--out", str(tmp_path / "run")]) == 1
+    err = capsys.readouterr().err
+    assert "trials × (episodes + test_episodes) = 2000000000000 episodes, more than the 10000000" in err, err
+    assert not (tmp_path / "run").exists()

@@ -8,6 +8,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "MAX_EPISODES",
+    "MAX_GP_POINTS",
     "BimanualPlant",
     "GpMap",
     "InternalError",
@@ -35,6 +37,10 @@ __all__ = [
 ]
 
 __version__: str
+MAX_GP_POINTS: int
+"""The most points of a GP map or the GPLVM objective (a 2 GiB N×N kernel matrix)."""
+MAX_EPISODES: int
+"""The most episode records of one run: trials × (episodes + test_episodes)."""
 
 class LatentrlError(ValueError):
     """Base class of latentrl's errors (a ValueError)."""

@@ -9,6 +9,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl._base import Estimator, SavedSpec, column_names, initial_log_theta, minimise_nll
+from latentrl import _native
 from latentrl._native import GpMap
 from latentrl._validation import as_matrix, int_at_least, positive
 from latentrl.inverse import Projection, fit_gp_encoder
@@ -145,6 +146,9 @@ class GPLVM(Estimator):
         names = column_names(X)
         X = as_matrix("X", X)
         check_n_components(self.n_components, X)
+        if len(X) > _native.MAX_GP_POINTS:
+            raise ValueError(f"X: {len(X)} postures, more than the {_native.MAX_GP_POINTS} a GPLVM fit takes "
+                             f"(its N × N kernel matrix would need {len(X) ** 2 * 8 / 2**30:.1f} GiB); subsample them")
         if not np.ptp(X, axis=0).any():
             raise ValueError(f"X: all {len(X)} postures are identical; a GPLVM needs postures that differ")
         max_iter = int_at_least("max_iter", self.max_iter, 1)

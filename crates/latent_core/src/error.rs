@@ -75,6 +75,18 @@ pub enum CoreError {
         /// The plant's error message.
         reason: String,
     },
+    /// An input larger than the core can hold: refused before anything is allocated.
+    #[error("{what}: {size} points need a {size}×{size} kernel matrix ({gib:.1} GiB); the limit is {limit} points")]
+    TooLarge {
+        /// Which argument.
+        what: &'static str,
+        /// Its number of points.
+        size: usize,
+        /// The most points allowed ([`crate::gp::MAX_GP_POINTS`]).
+        limit: usize,
+        /// The memory the kernel matrix would take (GiB).
+        gib: f64,
+    },
 }
 
 /// Result alias for the core.

@@ -23,6 +23,23 @@ pub struct GpMap {
     jitter: f64,
 }
 
+/// The most points a GP map or the GPLVM objective takes: its dense N×N kernel matrix is then
+/// 2 GiB. Larger inputs are refused before any allocation (they would abort the process).
+pub const MAX_GP_POINTS: usize = 16_384;
+
+/// [`CoreError::TooLarge`] unless `n` points fit under [`MAX_GP_POINTS`].
+pub(crate) fn check_gp_size(what: &'static str, n: usize) -> Result<()> {
+    if n > MAX_GP_POINTS {
+        return Err(CoreError::TooLarge {
+            what,
+            size: n,
+            limit: MAX_GP_POINTS,
+            gib: (n as f64).powi(2) * 8.0 / (1u64 << 30) as f64,
+        });
+    }
+    Ok(())
+}
+
 /// Reusable buffers for [`GpMap::predict_into`], so a prediction allocates nothing.
 #[derive(Debug, Clone)]
 pub struct PredictScratch {
@@ -38,6 +55,7 @@ impl GpMap {
         if n == 0 || inputs.nrows() == 0 {
             return Err(CoreError::Empty { what: "inputs" });
         }
+        check_gp_size("inputs", n)?;
         if outputs.ncols() != n || outputs.nrows() == 0 {
             return Err(CoreError::Shape {
                 what: "outputs",

@@ -27,6 +27,7 @@ pub fn nll_grad(latent: &DMatrix<f64>, centred: &DMatrix<f64>, log_theta: [f64; 
     if n == 0 || latent.nrows() == 0 {
         return Err(CoreError::Empty { what: "latent points" });
     }
+    crate::gp::check_gp_size("latent points", n)?;
     if centred.ncols() != n || centred.nrows() == 0 {
         return Err(CoreError::Shape {
             what: "data",

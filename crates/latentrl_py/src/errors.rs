@@ -79,7 +79,8 @@ pub fn to_py(err: CoreError) -> PyErr {
         | CoreError::InvalidParameter { .. }
         | CoreError::NoValidStart { .. }
         | CoreError::Param(_)
-        | CoreError::Plant { .. } => InvalidInputError::new_err(msg),
+        | CoreError::Plant { .. }
+        | CoreError::TooLarge { .. } => InvalidInputError::new_err(msg),
         CoreError::NotPositiveDefinite { .. } | CoreError::Overflow { .. } => NumericalError::new_err(msg),
     }
 }

@@ -16,6 +16,8 @@ use pyo3::prelude::*;
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
+    m.add("MAX_GP_POINTS", latent_core::gp::MAX_GP_POINTS)?;
+    m.add("MAX_EPISODES", runner::MAX_EPISODES)?;
     m.add_class::<gp::PyGpMap>()?;
     m.add_class::<world::PySim>()?;
     m.add_class::<task::PyTask>()?;

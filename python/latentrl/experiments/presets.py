@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from latentrl import _native
 from latentrl._validation import int_at_least
 
 
@@ -111,6 +112,12 @@ class LatentRun:
         check_ints(self, ("trials", "episodes", "gplvm_max_iter"))
         check_ints(self, ("seed", "test_episodes"), minimum=0)
         check_floats(self, ("latent_margin",), positive=False)
+        records = self.trials * (self.episodes + self.test_episodes)
+        if records > _native.MAX_EPISODES:
+            raise ValueError(
+                f"trials × (episodes + test_episodes) = {records} episodes, more than the {_native.MAX_EPISODES} "
+                "one run holds in memory; run fewer trials or episodes"
+            )
         if not isinstance(self.task, Mapping) or not all(isinstance(k, str) and "." in k for k in self.task):
             raise ValueError(f"task: expected overrides by key path such as {{'learner.alpha': 0.5}}, got {self.task!r}")
 
