@@ -129,3 +129,37 @@ def test_class_3_a_run_too_long_to_hold_is_refused_before_allocating(tmp_path, c
     err = capsys.readouterr().err
     assert "trials × (episodes + test_episodes) = 2000000000000 episodes, more than the 10000000" in err, err
     assert not (tmp_path / "run").exists()
+
+
+def test_class_6_and_7_demo_files_that_broke_the_reader_are_value_errors(tmp_path):
+    """A CSV field over csv's 131072-character limit (_csv.Error), JSON nested 10⁵ deep
+    (RecursionError), a FIFO (reported as an "empty file"), an oversized file."""
+    import os
+
+    from latentrl import load_demos
+    from latentrl.demos import MAX_DEMO_FILE_BYTES
+
+    (tmp_path / "long.csv").write_text("a,b\n1," + "2" * 200_000 + "\n")
+    with pytest.raises(ValueError, match="long.csv: field larger than field limit"):
+        load_demos(tmp_path / "long.csv")
+    (tmp_path / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(ValueError, match="deep.json: nested too deeply to read"):
+        load_demos(tmp_path / "deep.json")
+    os.mkfifo(tmp_path / "fifo.csv")
+    with pytest.raises(ValueError, match="fifo.csv: is not a regular file"):
+        load_demos(tmp_path / "fifo.csv")
+    with open(tmp_path / "huge.csv", "wb") as fh:
+        fh.truncate(MAX_DEMO_FILE_BYTES + 1)  # sparse: no disk used
+    with pytest.raises(ValueError, match=f"more than the {MAX_DEMO_FILE_BYTES} a demo file may have"):
+        load_demos(tmp_path / "huge.csv")
+
+
+def test_class_3_a_sweep_grid_too_large_is_refused_before_it_is_expanded(tmp_path, capsys):
+    """A 10⁶-cell grid was expanded in memory (3 GB) before any output."""
+    values = ", ".join(str(0.1 * (i + 1)) for i in range(10))
+    grid = "\n".join(f'"learner.{k}" = [{values}]' for k in ("alpha", "step", "rbf_width", "rbf_cutoff", "beta", "initial_weight"))
+    sweep = tmp_path / "big.toml"
+    sweep.write_text(f'experiment = "exp1"\n[grid]\n{grid}\n')
+    assert cli.main(["sweep", str(sweep), "--out", str(tmp_path / "out"), "--no-progress"]) == 1
+    assert "10 × 10 × 10 × 10 × 10 × 10 = 1000000 cells, more than the 10000" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

@@ -174,6 +174,10 @@ def _select(demos: Demonstrations, expected: Sequence[str]) -> Demonstrations:
     return Demonstrations(demos.postures[:, columns], tuple(expected))
 
 
+MAX_DEMO_FILE_BYTES = 256 * 2**20
+"""The largest demo file `load_demos` reads (it reads a file whole): 256 MiB."""
+
+
 def load_demos(
     path: PathLike, *, expected_joints: Sequence[str] | None = None, min_postures: int = 1
 ) -> Demonstrations:
@@ -185,14 +189,22 @@ def load_demos(
     """
     path = Path(path)
     read, _ = _format(path)
-    if path.stat().st_size == 0:
+    size = path.stat().st_size  # a missing file: FileNotFoundError, an OSError
+    if not path.is_file():
+        raise ValueError(f"{path}: is not a regular file (a directory, FIFO or device)")
+    if size == 0:
         raise ValueError(f"{path}: empty file")
+    if size > MAX_DEMO_FILE_BYTES:
+        raise ValueError(f"{path}: {size} bytes, more than the {MAX_DEMO_FILE_BYTES} a demo file may have "
+                         "(it is read whole); demonstrations are postures, not trajectories of millions of rows")
     try:
         demos = read(path)
         if expected_joints is not None:
             demos = _select(demos, tuple(expected_joints))
-    except ValueError as err:
+    except (ValueError, csv.Error) as err:
         raise ValueError(f"{path}: {err}") from err
+    except RecursionError as err:
+        raise ValueError(f"{path}: nested too deeply to read") from err
     if len(demos.postures) < min_postures:
         raise ValueError(
             f"{path}: {len(demos.postures)} postures, expected at least {min_postures}"

@@ -28,6 +28,9 @@ class SweepError(RuntimeError):
     """Some cells of a sweep failed; the others and every finished trial are saved."""
 
 
+MAX_CELLS = 10_000
+"""The most cells of one sweep: counted before the grid is expanded."""
+
 @dataclass(frozen=True)
 class Cell:
     """One point of a sweep: a full preset and where its results go."""
@@ -106,6 +109,11 @@ class Sweep:
             both = sorted(set(cell) & set(grid))
             if both:
                 raise ValueError(f"cells[{i}]: {', '.join(both)} also in the grid (set each field in one place)")
+        count = math.prod(len(v) for v in grid.values()) * max(1, len(cells))
+        if count > MAX_CELLS:
+            sizes = " × ".join([*(str(len(v)) for v in grid.values()), *([str(len(cells))] if cells else [])])
+            raise ValueError(f"grid: {sizes} = {count} cells, more than the {MAX_CELLS} a sweep may have "
+                             "(each is a full run); split it into several sweeps")
         object.__setattr__(self, "base", base)
         object.__setattr__(self, "grid", grid)
         object.__setattr__(self, "cells", cells)
