@@ -163,3 +163,29 @@ def test_class_3_a_sweep_grid_too_large_is_refused_before_it_is_expanded(tmp_pat
     assert cli.main(["sweep", str(sweep), "--out", str(tmp_path / "out"), "--no-progress"]) == 1
     assert "10 × 10 × 10 × 10 × 10 × 10 = 1000000 cells, more than the 10000" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+def _npy(shape: tuple[int, ...], payload: bytes = b"") -> bytes:
+    import io
+
+    buf = io.BytesIO()
+    np.lib.format.write_array_header_1_0(buf, {"descr": "<f8", "fortran_order": False, "shape": shape})
+    return buf.getvalue() + payload
+
+
+def test_class_3_model_files_that_would_unpack_huge_are_refused_before_unpacking(tmp_path, monkeypatch):
+    """An NPZ whose header declares 10¹² elements, and a zip bomb (here: over a lowered limit)."""
+    import zipfile
+
+    from latentrl import GPLVM, _base
+
+    with zipfile.ZipFile(tmp_path / "declared.npz", "w") as archive:
+        archive.writestr("format.npy", _npy((10**12,), b"\0" * 64))
+    with pytest.raises(ValueError, match="refused NPZ file: format.npy: its header declares 8000000000000 bytes"):
+        GPLVM.load(tmp_path / "declared.npz")
+    monkeypatch.setattr(_base, "MAX_NPZ_BYTES", 2**20)
+    with zipfile.ZipFile(tmp_path / "bomb.npz", "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("a.npy", _npy((2**18,), b"\0" * 2**21))
+    assert (tmp_path / "bomb.npz").stat().st_size < 10_000
+    with pytest.raises(ValueError, match=r"refused NPZ file: it unpacks to \d+ bytes, more than the 1048576"):
+        GPLVM.load(tmp_path / "bomb.npz")

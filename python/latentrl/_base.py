@@ -56,6 +56,34 @@ def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
         raise
 
 
+MAX_NPZ_BYTES = 2**30
+"""The most bytes of arrays an NPZ file read by latentrl (a model, a run's returns) may unpack to."""
+
+
+class _TooLarge(ValueError):
+    """An NPZ archive refused for its size, not for being corrupt."""
+
+
+def _check_npz_sizes(fh: IO[bytes]) -> None:
+    """Refuses, before anything is unpacked, an archive that would unpack to more than
+    MAX_NPZ_BYTES (a zip bomb) or a member whose header declares more data than the member
+    holds (an array of 10¹² elements in a small file)."""
+    with zipfile.ZipFile(fh) as archive:
+        members = archive.infolist()
+        total = sum(m.file_size for m in members)
+        if total > MAX_NPZ_BYTES:
+            raise _TooLarge(f"it unpacks to {total} bytes, more than the {MAX_NPZ_BYTES} latentrl reads")
+        for member in members:
+            with archive.open(member) as item:
+                version = np.lib.format.read_magic(item)
+                read_header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+                shape, _, dtype = read_header(item)
+                declared = int(np.prod(shape, dtype=object)) * dtype.itemsize
+                if declared > member.file_size:
+                    raise _TooLarge(f"{member.filename}: its header declares {declared} bytes of data, the "
+                                    f"member holds {member.file_size}")
+
+
 def read_npz(path: PathLike) -> dict[str, NDArray[Any]]:
     """Every array of the NPZ file at `path`, read eagerly without pickles; a file that
     is not a readable NPZ is a ValueError."""
@@ -67,11 +95,15 @@ def read_npz(path: PathLike) -> dict[str, NDArray[Any]]:
             raise ValueError("not a readable NPZ file: it has no zip archive header (latentrl writes models and results as .npz)")
         fh.seek(0)
         try:
+            _check_npz_sizes(fh)
+            fh.seek(0)
             npz = np.load(fh, allow_pickle=False)
             if not isinstance(npz, np.lib.npyio.NpzFile):
                 raise ValueError("it holds a single array, not an NPZ archive")
             with npz:
                 return {key: npz[key] for key in npz.files}
+        except _TooLarge as err:
+            raise ValueError(f"refused NPZ file: {err}") from None
         except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as err:
             raise ValueError(f"not a readable NPZ file (corrupt or truncated?): {err}") from err
 
