@@ -189,3 +189,25 @@ def test_class_3_model_files_that_would_unpack_huge_are_refused_before_unpacking
     assert (tmp_path / "bomb.npz").stat().st_size < 10_000
     with pytest.raises(ValueError, match=r"refused NPZ file: it unpacks to \d+ bytes, more than the 1048576"):
         GPLVM.load(tmp_path / "bomb.npz")
+
+
+def _chain(links: int) -> str:
+    """A URDF chain of `links` links and revolute joints."""
+    inertial = '<inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>'
+    body = "".join(f'<link name="l{i}">{inertial}</link>' for i in range(links))
+    joints = "".join(JOINT.format(name=f"j{i}", parent=f"l{i}", child=f"l{i + 1}") for i in range(links - 1))
+    return f'<robot name="chain">{body}{joints}</robot>'
+
+
+def test_class_1_a_urdf_nested_too_deep_is_refused_before_parsing():
+    """50 000 nested elements overflowed the parser's stack (SIGSEGV)."""
+    deep = '<robot name="r"><link name="a">' + "<x>" * 50_000 + "</x>" * 50_000 + "</link></robot>"
+    with pytest.raises(InvalidInputError, match="elements nested 50002 deep, more than the 256 a URDF may have"):
+        Sim(deep)
+
+
+def test_class_2_a_urdf_with_too_many_links_is_refused_before_building():
+    """1000 links took 10 s to build, 10 000 over 3 minutes, deaf to Ctrl-C."""
+    with pytest.raises(InvalidInputError, match="501 links, more than the 500 a robot may have"):
+        Sim(_chain(501))
+    assert len(Sim(_chain(20)).joint_names) == 19  # a robot within the limit builds

@@ -28,7 +28,8 @@ use crate::error::{Result, SimError};
 
 mod check;
 mod insert;
-use check::{check_joint_types, check_robot};
+pub use check::{MAX_URDF_DEPTH, MAX_URDF_LINKS};
+use check::{check_joint_types, check_robot, check_size};
 pub(crate) use insert::JointSlot;
 
 choice! {
@@ -136,8 +137,11 @@ impl UrdfModel {
     /// inequality or has a radius of gyration outside [1 µm, 1 km], non-finite inertial or
     /// collision poses, negative or non-finite collision sizes, a zero axis, a length or joint
     /// limit beyond ±1000 (m or rad), or a number too large for rapier's f32 (|value| > 3.4e38);
-    /// [`SimError::UnsupportedGeometry`] for mesh collision shapes.
+    /// [`SimError::UnsupportedGeometry`] for mesh collision shapes. A document nested deeper
+    /// than [`MAX_URDF_DEPTH`] or with more than [`MAX_URDF_LINKS`] links is refused as
+    /// malformed before it is parsed.
     pub fn parse_named(xml: &str, origin: &str) -> Result<Self> {
+        check_size(xml, origin)?;
         check_joint_types(xml, origin)?;
         let robot = urdf_rs::read_from_string(xml).map_err(|e| SimError::MalformedUrdf {
             origin: origin.to_string(),
