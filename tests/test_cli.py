@@ -34,6 +34,9 @@ def test_info_prints_versions_git_revision_and_threads_as_json():
                               cwd=Path(__file__).parent).stdout.strip()
     assert info["git_revision"] == (revision or None)
     assert info["cpu_count"] >= 1 and info["rayon_threads"] >= 1
+    # What decides the last bits on another machine (docs/robustness.md): SIMD flags, BLAS.
+    assert set(info["cpu_flags"]) <= {"sse4_2", "avx", "avx2", "fma", "avx512f", "avx512dq", "avx512vl"}
+    assert info["blas"]["name"] and "OPENBLAS_CORETYPE" in info["blas"]
     env = {**os.environ, "RAYON_NUM_THREADS": "1"}
     one = subprocess.run([sys.executable, "-m", "latentrl", "info"], capture_output=True, text=True, env=env)
     assert json.loads(one.stdout)["rayon_threads"] == 1

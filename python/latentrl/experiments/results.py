@@ -80,6 +80,8 @@ def environment() -> dict[str, Any]:
         "python": platform.python_version(),
         "platform": platform.platform(),
         "cpu": _cpu_model(),
+        "cpu_flags": _cpu_flags(),
+        "blas": _blas(),
         "git_revision": _git_revision(),
         "cpu_count": os.cpu_count(),
         "rayon_threads": worker_threads(),
@@ -95,6 +97,38 @@ def _cpu_model() -> str:
     except OSError:
         pass
     return platform.processor()
+
+
+SIMD_FLAGS = ("sse4_2", "avx", "avx2", "fma", "avx512f", "avx512dq", "avx512vl")
+"""The CPU features that change floating-point results here (libm and BLAS kernels pick by them)."""
+
+
+def _cpu_flags() -> list[str]:
+    """Which of SIMD_FLAGS the CPU has (Linux: /proc/cpuinfo; empty elsewhere)."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("flags"):
+                have = set(line.split(":", 1)[1].split())
+                return [flag for flag in SIMD_FLAGS if flag in have]
+    except OSError:
+        pass
+    return []
+
+
+def _blas() -> dict[str, Any]:
+    """NumPy's BLAS (name, version, build configuration) and an OPENBLAS_CORETYPE override: the
+    GPLVM fit's last bits depend on the kernel OpenBLAS picks for the CPU."""
+    config: dict[str, Any] = {}
+    try:
+        config = dict(np.show_config(mode="dicts")["Build Dependencies"]["blas"])
+    except (KeyError, TypeError):
+        pass
+    return {
+        "name": config.get("name"),
+        "version": config.get("version"),
+        "configuration": config.get("openblas configuration"),
+        "OPENBLAS_CORETYPE": os.environ.get("OPENBLAS_CORETYPE"),
+    }
 
 
 def worker_threads() -> int:
