@@ -211,3 +211,16 @@ def test_class_2_a_urdf_with_too_many_links_is_refused_before_building():
     with pytest.raises(InvalidInputError, match="501 links, more than the 500 a robot may have"):
         Sim(_chain(501))
     assert len(Sim(_chain(20)).joint_names) == 19  # a robot within the limit builds
+
+
+def test_class_7_a_bad_out_is_refused_before_any_work(tmp_path, capsys):
+    """A bad --out was refused only after a 7 s fit."""
+    demos = tmp_path / "demos.csv"
+    demos.write_text("a,b\n" + "\n".join(f"{i},{i * i}" for i in range(10)) + "\n")
+    assert cli.main(["fit", str(demos), "--out", str(tmp_path)]) == 1
+    assert "is a directory, expected a file" in capsys.readouterr().err
+    (tmp_path / "file").write_text("x")
+    assert cli.main([*TINY, "--out", str(tmp_path / "file")]) == 1
+    assert "is a file, expected a directory" in capsys.readouterr().err
+    assert cli.main([*TINY, "--out", str(tmp_path / "file" / "run")]) == 1  # under a file
+    assert f"cannot write under {tmp_path / 'file'}" in capsys.readouterr().err

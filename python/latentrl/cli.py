@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import os
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -331,6 +332,19 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_writable(out: Path, *, file: bool) -> None:
+    """`--out` can be written: its nearest existing ancestor is a writable directory (and it is
+    not a directory where a file goes, or a file where a directory goes). Checked before any
+    fit or trial, so a typo costs nothing."""
+    if out.exists() and out.is_dir() == file:
+        raise ValueError(f"--out {out}: is {'a directory' if file else 'a file'}, expected {'a file' if file else 'a directory'}")
+    parent = (out.parent if file else out).absolute()
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir() or not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"--out {out}: cannot write under {parent}")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
     args = build_parser().parse_args(argv)
@@ -339,6 +353,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     command = {"run": _run, "train": _train, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep}
     try:
+        out = getattr(args, "out", None)
+        if out is not None:
+            _check_writable(out, file=args.command == "fit")
         return command[args.command](args)
     except (ValueError, OSError) as err:
         print(f"latentrl: error: {err}", file=sys.stderr)
