@@ -236,3 +236,11 @@ def test_params_and_repr():
         "encoder",
         "tol",
     }
+
+
+def test_inverse_transform_returns_the_variance_from_the_same_call(X, model):
+    Z = model.Z_[:5] + 0.1
+    mean, variance = model.inverse_transform(Z, return_variance=True)
+    np.testing.assert_array_equal(mean, model.inverse_transform(Z))
+    np.testing.assert_array_equal(variance, model.predict_variance(Z))
+    assert variance.shape == (5,) and np.all(variance > model.theta_[2] * 0.999)  # ≥ the noise θ3

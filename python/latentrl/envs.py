@@ -369,14 +369,17 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
         u = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
         target_z = self.z + u
         variance = None
-        if self.variance_threshold is not None:
-            variance = float(self.model.predict_variance(target_z[None])[0])
+        if self.variance_threshold is not None:  # a GPLVM: mean and variance in one native call
+            decoded, variances = self.model.inverse_transform(target_z[None], return_variance=True)
+            variance = float(variances[0])
+        else:
+            decoded = self.model.inverse_transform(target_z[None])
         refused = _native.latent_refusal(
             list(target_z), list(self.latent_low), list(self.latent_high), variance, self.variance_threshold
         )
         if refused is not None:
             return self.z.copy(), self.penalty, True, False, {"end_reason": end_reasons()[refused]}
-        target = self.model.inverse_transform(target_z[None])[0]
+        target = decoded[0]
         origin = np.asarray(self.env.unwrapped.action_origin)  # type: ignore[attr-defined]
         _, reward, terminated, truncated, info = self.env.step(target - origin)
         self.z = self._encode()

@@ -3,7 +3,7 @@ decodes to the demonstrated postures, with two inverse maps to encode."""
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, Self
+from typing import Any, ClassVar, Literal, Self, overload
 
 import numpy as np
 from numpy.typing import NDArray
@@ -225,11 +225,24 @@ class GPLVM(Estimator):
         X = self._check_X(X)
         return self.encoder_.predict_mean(X) if method == "gp" else self.projection_.encode(X)
 
-    def inverse_transform(self, Z: Any) -> NDArray[np.float64]:
+    @overload
+    def inverse_transform(self, Z: Any, return_variance: Literal[False] = False) -> NDArray[np.float64]: ...
+    @overload
+    def inverse_transform(
+        self, Z: Any, return_variance: Literal[True]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]: ...
+
+    def inverse_transform(
+        self, Z: Any, return_variance: bool = False
+    ) -> NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Decodes latent points `Z` (M, d) to postures (M, D): the GP mean (Eq. 4), an
-        ndarray, its columns in the order of `feature_names_in_`."""
+        ndarray, its columns in the order of `feature_names_in_`. With `return_variance`, also
+        the predictive variance σ²(z) (M,) of `predict_variance`, from the same native call."""
         self._check_fitted()
-        return self.decoder_.predict_mean(as_matrix("Z", Z, n_cols=self._n_features_out))
+        Z = as_matrix("Z", Z, n_cols=self._n_features_out)
+        if return_variance:
+            return self.decoder_.predict(Z)
+        return self.decoder_.predict_mean(Z)
 
     def predict_variance(self, Z: Any) -> NDArray[np.float64]:
         """Predictive variance σ²(z) (M,) at latent points `Z` (M, d), θ3 included (Eq. 4)."""
