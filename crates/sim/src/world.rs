@@ -21,8 +21,10 @@ use crate::urdf::{JointSlot, RootMode, UrdfModel};
 
 mod config;
 mod readout;
+mod snapshot;
 pub use config::{JointServo, PhysicsConfig, ServoConfig, WorldConfig};
 pub use readout::Frame;
+pub use snapshot::WorldSnapshot;
 
 /// An obstacle in the world and its collider.
 #[derive(Debug, Clone)]
@@ -44,7 +46,7 @@ pub struct World {
     pub(crate) root: RigidBodyHandle,
     pub(crate) ground: Option<ColliderHandle>,
     pub(crate) obstacles: Vec<ObstacleEntry>,
-    time: f64,
+    pub(crate) time: f64,
 }
 
 impl World {

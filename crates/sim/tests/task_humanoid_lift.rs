@@ -139,6 +139,10 @@ fn an_episode_does_not_depend_on_the_one_before() {
     p.reset(&d[5]);
     let again = walk(&mut p, &d[5], &d[6], 10);
     assert_eq!(first, again);
+    // The reset restores a snapshot of the world as built: the same bits as a fresh build.
+    let mut fresh = TaskPlant::new(task.clone(), Some(&d)).unwrap();
+    fresh.reset(&d[5]);
+    assert_eq!(walk(&mut fresh, &d[5], &d[6], 10), first, "restored world vs freshly built world");
 }
 
 /// GP maps through the 7 demos on a hand-made latent layout: z0 = style (−1 hinge, 1 squat),

@@ -10,9 +10,10 @@
 //! a centre of mass outside the support (`fall.min_start_margin`) as well.
 //!
 //! Resets: a fixed-root robot is reset in place (every coordinate set exactly); a floating
-//! robot, or one among solid obstacles, gets a fresh world per episode and stands with its
-//! first sole flat on the floor — rapier keeps warm-start contact impulses across a teleport,
-//! so a reset in place would make an episode depend on the one before.
+//! robot, or one among solid obstacles, gets a fresh world per episode (the world as built,
+//! restored from a snapshot) and stands with its first sole flat on the floor — rapier keeps
+//! warm-start contact impulses across a teleport, so a reset in place would make an episode
+//! depend on the one before.
 
 use std::sync::Arc;
 
@@ -25,7 +26,7 @@ use crate::error::{Result, SimError};
 use crate::fall::{FallCriteria, reset_on_ground, support_margin};
 use crate::shapes::{Obstacle, ObstacleShape};
 use crate::urdf::RootMode;
-use crate::world::{Frame, World};
+use crate::world::{Frame, World, WorldSnapshot};
 
 /// Height (m) above the floor of the lowest sole corner at a reset.
 const CLEARANCE: f64 = 5e-4;
@@ -57,7 +58,8 @@ pub struct TaskPlant {
     target: Vec<f64>,
     effectors: Vec<f64>,
     fall: Option<FallCriteria>,
-    rebuild: bool,
+    /// The world as built, restored at every reset when episodes need a fresh world.
+    pristine: Option<WorldSnapshot>,
     home: Vec<f64>,
     started_below: bool,
     went_above: bool,
@@ -112,6 +114,7 @@ impl TaskPlant {
                 .iter()
                 .any(|o| !o.sensor && o.test == ObstacleTest::Links);
         let world = Self::fresh_world(&task)?;
+        let pristine = rebuild.then(|| world.snapshot());
         let effector_frames = config
             .effectors
             .iter()
@@ -160,7 +163,7 @@ impl TaskPlant {
             effectors: vec![0.0; 3 * config.effectors.len()],
             fall: task.fall_criteria(),
             task: Arc::clone(&task),
-            rebuild,
+            pristine,
             home,
             started_below: false,
             went_above: false,
@@ -191,8 +194,8 @@ impl TaskPlant {
     /// Puts the robot at `posture`: in place (fixed root), or in a fresh world standing on
     /// the floor (floating root, solid obstacles), and sets the fall test's base height.
     fn stand(&mut self, posture: &[f64]) -> Result<()> {
-        if self.rebuild {
-            self.world = Self::fresh_world(&self.task)?;
+        if let Some(pristine) = &self.pristine {
+            self.world.restore(pristine);
         }
         match (&mut self.fall, self.task.config().floor.as_ref()) {
             (Some(fall), Some(floor)) => {
