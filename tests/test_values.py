@@ -1,6 +1,6 @@
 """V across languages (issue #22): the value function the figures and `LatentPolicy.value` show is
 the Rust learner's own (its sparse RBF features, its grid order), checked against the plain-NumPy
-reference at random latent points after real training, in 2-D and 3-D latent spaces."""
+reference at random latent points after real training, in 1-D, 2-D and 3-D latent spaces."""
 
 import numpy as np
 import pytest
@@ -10,7 +10,7 @@ from latentrl.datasets import arm_postures
 from latentrl.train import train_latent_policy
 
 
-@pytest.fixture(scope="module", params=[2, 3], ids=["d2", "d3"])
+@pytest.fixture(scope="module", params=[1, 2, 3], ids=["d1", "d2", "d3"])
 def trained(request):
     model = GPLVM(n_components=request.param, max_iter=40, random_state=0).fit(arm_postures(40, np.random.default_rng(2)))
     overrides = {"episode.max_steps": 40, "learner.rbf_per_dim": 8}
