@@ -140,7 +140,10 @@ def test_stub_declares_the_native_module():
     declared = {
         node.name: node for node in stub.body if isinstance(node, (ast.ClassDef, ast.FunctionDef))
     }
-    assert set(declared) | {"__version__"} == set(_native.__all__)
+    constants = {node.target.id for node in stub.body if isinstance(node, ast.AnnAssign)}
+    assert constants == {"__version__", "MAX_EPISODES", "MAX_GP_POINTS"}
+    assert all(isinstance(getattr(_native, name), int) for name in constants - {"__version__"})
+    assert set(declared) | constants == set(_native.__all__)
     assert isinstance(_native.__version__, str) and latentrl.__version__ == _native.__version__
 
     def stub_params(node):
