@@ -21,6 +21,7 @@ from latentrl import _native
 from latentrl.experiments.presets import field_docs, with_overrides
 from latentrl.experiments.registry import experiments, task_schema
 from latentrl.experiments.results import environment, read_json, write_json
+from latentrl.task import by_path
 
 TASK_PREFIX = "task:"
 """Prefix of the argparse destinations of task keys (`task:learner.alpha`)."""
@@ -100,7 +101,7 @@ def _add_task_flags(
     groups: dict[str, Any] = {}
     for entry in schema:
         key = entry["key"]
-        if "." not in key or "[]" in key or "NAME" in key or entry["kind"].startswith("table"):
+        if not by_path(entry) or entry["kind"].startswith("table"):
             continue
         table, _, name = key.rpartition(".")
         group = groups.setdefault(table, parser.add_argument_group(f"[{table}] (task keys)"))

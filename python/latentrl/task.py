@@ -40,6 +40,13 @@ def schema() -> tuple[dict[str, Any], ...]:
     return tuple(_native.task_schema())
 
 
+def by_path(entry: Mapping[str, Any]) -> bool:
+    """Whether a schema key can be set by its dotted path (`learner.alpha`): a key of a table,
+    not one of each list item (`constraints[].kind`) or of each named entry (`servo.joints.NAME.kp`)."""
+    key = entry["key"]
+    return "." in key and "[]" not in key and "NAME" not in key
+
+
 def _plain(value: Any) -> Any:
     """`value` with every tuple and list a fresh list and every dict a fresh dict."""
     if isinstance(value, dict):

@@ -34,6 +34,12 @@ def write_json(path: Path, payload: Mapping[str, Any]) -> None:
     atomic_write(path, lambda f: f.write(text.encode()))
 
 
+def as_saved(value: Any) -> Any:
+    """`value` as `write_json` stores it and `read_json` gives it back (NumPy values, dataclasses
+    and paths made plain): the form a saved run is compared in."""
+    return json.loads(json.dumps(value, default=_to_plain, allow_nan=True))
+
+
 def write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
     """Atomic compressed NPZ."""
     # numpy's stub types **kwds as if a key could be `allow_pickle`; ours are array names.

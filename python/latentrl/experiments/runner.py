@@ -23,6 +23,7 @@ from latentrl._base import read_npz
 from latentrl.task import end_reasons
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
+    as_saved,
     environment,
     peak_rss_mib,
     read_json,
@@ -143,7 +144,7 @@ def run_rl(
     built = setup(preset)
     if meta is not None:
         _check_same_fit(meta, built, arrays, out)
-    arrays[PRESET_KEY] = np.array(json.dumps(plan, sort_keys=True, default=str))
+    arrays[PRESET_KEY] = np.array(json.dumps(as_saved(plan), sort_keys=True))
     chunk = chunk or worker_threads()
     if meta is None:
         meta = {"preset": plan, "environment": environment(), "setup": built.info, "wall_time_s": 0.0}
@@ -272,10 +273,10 @@ def _check_saved_run(out: Path, plan: dict[str, Any], arrays: Mapping[str, np.nd
     """The arrays of a run being continued were computed with `plan`; a ValueError naming the
     edited fields otherwise (mixing would be silently wrong)."""
     if PRESET_KEY in arrays:
-        saved = json.loads(str(arrays[PRESET_KEY]))
-        edited = sorted(k for k in set(saved) | set(plan) if saved.get(k) != json.loads(json.dumps(plan.get(k), default=str)))
+        saved, now = json.loads(str(arrays[PRESET_KEY])), as_saved(plan)
+        edited = sorted(k for k in set(saved) | set(now) if saved.get(k) != now.get(k))
         if edited:
-            changes = ", ".join(f"{k}: {saved.get(k)!r} in returns.npz, {plan.get(k)!r} in results.json" for k in edited)
+            changes = ", ".join(f"{k}: {saved.get(k)!r} in returns.npz, {now.get(k)!r} in results.json" for k in edited)
             raise ValueError(f"{out}/results.json was edited after its trials ran ({changes}); resume refuses to mix "
                              "the two: restore the file, or start a new run with --out")
 
@@ -293,10 +294,10 @@ def _check_same_fit(meta: Mapping[str, Any], built: Setup, arrays: Mapping[str, 
                                  f"{want} (trials, episodes); it belongs to another run")
     saved, now = meta.get("setup", {}).get("gplvm"), built.info.get("gplvm")
     if saved is not None and now is not None:
-        now_plain = json.loads(json.dumps(now, default=lambda v: np.asarray(v).tolist()))
-        if saved != now_plain:
+        now = as_saved(now)
+        if saved != now:
             raise ValueError(
-                f"{out}: the GPLVM fitted now (nll {now_plain.get('nll')}) is not the one the saved trials used "
+                f"{out}: the GPLVM fitted now (nll {now.get('nll')}) is not the one the saved trials used "
                 f"(nll {saved.get('nll')}): an edited seed, or another machine's BLAS; resume refuses to mix them"
             )
 

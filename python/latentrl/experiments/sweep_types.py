@@ -19,6 +19,7 @@ from typing import Any, NamedTuple
 
 from latentrl.experiments.presets import describe, with_overrides
 from latentrl.experiments.registry import rl_experiments, task_schema
+from latentrl.task import by_path
 
 SWEEP_KEYS = ("experiment", "quick", "trials", "seed", "threshold", "base", "grid", "cells")
 """The keys of a sweep file, as the fields of `Sweep`."""
@@ -214,8 +215,7 @@ def _task_kinds(experiment: str) -> dict[str, type]:
     """Scalar task keys of `experiment` (by path) → the type a sweep value must have; choices
     and optional values are strings or numbers checked by the task itself (`object`)."""
     types = {"float": float, "int": int, "bool": bool, "str": str}
-    return {e["key"]: types.get(e["kind"], object) for e in task_schema(experiment)
-            if "." in e["key"] and "[]" not in e["key"] and "NAME" not in e["key"]}
+    return {e["key"]: types.get(e["kind"], object) for e in task_schema(experiment) if by_path(e)}
 
 
 def _flat(table: Any) -> Any:
