@@ -224,3 +224,17 @@ def test_class_7_a_bad_out_is_refused_before_any_work(tmp_path, capsys):
     assert "is a file, expected a directory" in capsys.readouterr().err
     assert cli.main([*TINY, "--out", str(tmp_path / "file" / "run")]) == 1  # under a file
     assert f"cannot write under {tmp_path / 'file'}" in capsys.readouterr().err
+
+
+def test_class_1_a_task_dict_nested_too_deep_is_refused_before_converting():
+    """200 000 nested lists overflowed the stack of the dict conversion (SIGSEGV)."""
+    from latentrl import Task
+
+    deep: list = [0.0]
+    for _ in range(200_000):
+        deep = [deep]
+    arms = Task.shipped("two_arms")
+    config = arms.to_dict()
+    config["target"]["position"] = deep
+    with pytest.raises(ValueError, match="target.position: nested deeper than 32 lists or tables"):
+        Task.from_dict(config, arms.base_dir)

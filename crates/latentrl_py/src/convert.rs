@@ -45,6 +45,19 @@ pub fn to_vector<'py>(py: Python<'py>, vector: DVector<f64>) -> Bound<'py, PyArr
     PyArray1::from_vec(py, vector.data.into())
 }
 
+/// The Python type name of `value`, for error messages.
+pub(crate) fn type_name(value: &Bound<'_, PyAny>) -> String {
+    value
+        .get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".into())
+}
+
+/// The deepest nesting of lists and dicts a configuration may have (a task nests 4 levels;
+/// the conversion recurses per level, and 200 000 nested lists overflowed the stack).
+const MAX_CONFIG_DEPTH: usize = 32;
+
 /// Borrowed names (joints, links) as Python strings.
 pub fn owned(names: Vec<&str>) -> Vec<String> {
     names.into_iter().map(str::to_string).collect()
@@ -64,13 +77,9 @@ pub fn config_from<T: DeserializeOwned>(what: &str, value: &Bound<'_, PyAny>) ->
         InvalidInputError::new_err(format!("{what}: {at}{message}"))
     };
     if !value.is_instance_of::<PyDict>() {
-        let kind = value
-            .get_type()
-            .name()
-            .map_or_else(|_| "?".to_string(), |n| n.to_string());
-        return Err(fail("", format!("expected a dict of keys, got {kind}")));
+        return Err(fail("", format!("expected a dict of keys, got {}", type_name(value))));
     }
-    let value = toml_value(value, "").map_err(|(path, message)| fail(&path, message))?;
+    let value = toml_value(value, "", 0).map_err(|(path, message)| fail(&path, message))?;
     serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
         fail(&path, e.into_inner().message().to_string())
@@ -79,7 +88,7 @@ pub fn config_from<T: DeserializeOwned>(what: &str, value: &Bound<'_, PyAny>) ->
 
 /// A Python value as a TOML value, by its own type: a bool is never a number, a string never a
 /// bool (NumPy arrays and scalars through `tolist`). Err: (key path, what is wrong).
-fn toml_value(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, (String, String)> {
+fn toml_value(value: &Bound<'_, PyAny>, path: &str, depth: usize) -> Result<toml::Value, (String, String)> {
     let join = |key: &str| {
         if path.is_empty() {
             key.to_string()
@@ -88,6 +97,9 @@ fn toml_value(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, (Stri
         }
     };
     let wrong = |what: String| (path.to_string(), what);
+    if depth > MAX_CONFIG_DEPTH {
+        return Err(wrong(format!("nested deeper than {MAX_CONFIG_DEPTH} lists or tables")));
+    }
     if let Ok(b) = value.cast::<PyBool>() {
         return Ok(toml::Value::Boolean(b.is_true()));
     }
@@ -110,7 +122,7 @@ fn toml_value(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, (Stri
                 .extract()
                 .map_err(|_| wrong(format!("a key must be a string, got {k}")))?;
             if !v.is_none() {
-                let item = toml_value(&v, &join(&key))?;
+                let item = toml_value(&v, &join(&key), depth + 1)?;
                 table.insert(key, item);
             }
         }
@@ -118,7 +130,7 @@ fn toml_value(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, (Stri
     }
     if value.hasattr("tolist").unwrap_or(false) && !value.is_instance_of::<PyList>() {
         let plain = value.call_method0("tolist").map_err(|e| wrong(e.to_string()))?;
-        return toml_value(&plain, path);
+        return toml_value(&plain, path, depth);
     }
     if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
         let items = value.try_iter().map_err(|e| wrong(e.to_string()))?;
@@ -128,16 +140,13 @@ fn toml_value(value: &Bound<'_, PyAny>, path: &str) -> Result<toml::Value, (Stri
             if item.is_none() {
                 return Err(wrong(format!("item {i} is None")));
             }
-            array.push(toml_value(&item, path)?);
+            array.push(toml_value(&item, path, depth + 1)?);
         }
         return Ok(toml::Value::Array(array));
     }
-    let kind = value
-        .get_type()
-        .name()
-        .map_or_else(|_| "?".to_string(), |n| n.to_string());
     Err(wrong(format!(
-        "invalid type: {kind} {value}, expected a bool, number, string, list or dict"
+        "invalid type: {} {value}, expected a bool, number, string, list or dict",
+        type_name(value)
     )))
 }
 

@@ -10,6 +10,7 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use crate::convert::type_name;
 use crate::errors::{InvalidInputError, to_py};
 use crate::gp::PyGpMap;
 
@@ -35,14 +36,6 @@ pub(crate) fn int_in(name: &str, value: &Bound<'_, PyAny>, min: i128, max: i128)
         return Err(invalid(format!("{name} must lie in [{min}, {max}], got {v}")));
     }
     Ok(v)
-}
-
-pub(crate) fn type_name(value: &Bound<'_, PyAny>) -> String {
-    value
-        .get_type()
-        .name()
-        .map(|n| n.to_string())
-        .unwrap_or_else(|_| "?".into())
 }
 
 pub(crate) fn gp_map<'a, 'py>(
