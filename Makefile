@@ -47,12 +47,13 @@ test-all: lint $(VENV)/.sb3 ## everything, slow reproductions and the SB3 exampl
 	cargo test --quiet -p latentrl_py --lib
 	$(PY) -m pytest -q -m ''
 
-bench: build ## criterion benches, the NumPy loop, GPy and MuJoCo comparisons (JSON in benches/results/)
+bench: build ## criterion benches, the NumPy loop, GPy, MuJoCo and Pinocchio comparisons (JSON in benches/results/)
 	cargo bench -p latent_core -p sim
 	$(PY) benches/bench_td.py
 	bash benches/setup_bench_env.sh
 	benches/.venv-bench/bin/python benches/bench_gp.py
 	benches/.venv-bench/bin/python benches/bench_sim.py
+	benches/.venv-bench/bin/python benches/bench_urdf.py
 
 lint: build ## rustfmt, clippy (warnings are errors), the native stubs against the module, mypy --strict
 	cargo fmt --all --check

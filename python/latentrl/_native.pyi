@@ -34,6 +34,7 @@ __all__ = [
     "run_bimanual_trials",
     "run_task_trials",
     "task_schema",
+    "urdf_info",
 ]
 
 __version__: str
@@ -260,8 +261,7 @@ class Task:
     def link_names(self) -> list[str]:
         """Names of every URDF link, in URDF order."""
     def collision_shapes(self) -> list[dict[str, Any]]:
-        """Every collision shape: dicts `{link, kind, size, origin}` (origin: the pose in the link's
-        frame, position and quaternion x, y, z, w), to draw the robot."""
+        """Every collision shape as a dict (`urdf_info`'s shapes), to draw the robot."""
     @property
     def effectors(self) -> list[str]:
         """The names of the task's effectors."""
@@ -380,5 +380,13 @@ def task_schema() -> list[dict[str, Any]]:
 def bimanual_schema() -> list[dict[str, Any]]:
     """The keys of Experiment 1's configuration (`plant.*`, `learner.*`), as `task_schema`."""
 
+def urdf_info(path: str | PathLike[str]) -> dict[str, Any]:
+    """Reads and checks a URDF file (meshes hulled, through the cache) and returns what it holds:
+    `{name, joints, links, collision, visual, total_mass}`; each joint a dict `{name, type,
+    lower, upper, effort, velocity, damping, friction, mimic}` (mimic: `{leader, multiplier,
+    offset}` or None), actuated joints first in URDF order, then the mimic ones. Each shape a
+    dict `{link, kind, size, origin, file, hull}` (origin: position and quaternion x, y, z, w in
+    the link's frame; file: a mesh's resolved path or None; hull: `{triangles, vertices,
+    cached}` for a collision mesh, else None)."""
 def end_reasons() -> list[str]:
     """The end reasons by code: their names in results files (0 timeout … 5 variance_gate)."""

@@ -178,6 +178,9 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--resume", action="store_true", help="continue the sweep in --out; finished trials are kept")
     sweep.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     sub.add_parser("info", help="print versions, git revision and thread count as JSON")
+    urdf = sub.add_parser("urdf-info", help="what a URDF holds as the physics loads it: joints, links, collision shapes, mass")
+    urdf.add_argument("urdf", type=Path, help="the robot's URDF file")
+    urdf.add_argument("--json", action="store_true", help="print it as JSON instead of a table")
     return parser
 
 
@@ -333,6 +336,14 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _urdf_info(args: argparse.Namespace) -> int:
+    from latentrl.robot_info import format_info, urdf_info
+
+    info = urdf_info(args.urdf)
+    print(json.dumps(info, indent=2) if args.json else format_info(info))
+    return 0
+
+
 def _check_writable(out: Path, *, file: bool) -> None:
     """`--out` can be written: its nearest existing ancestor is a writable directory (and it is
     not a directory where a file goes, or a file where a directory goes). Checked before any
@@ -352,7 +363,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "info":
         print(json.dumps(environment(), indent=2))
         return 0
-    command = {"run": _run, "train": _train, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep}
+    command = {"run": _run, "train": _train, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep,
+               "urdf-info": _urdf_info}
     try:
         out = getattr(args, "out", None)
         if out is not None:

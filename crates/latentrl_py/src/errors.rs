@@ -95,7 +95,7 @@ pub fn sim_to_py(err: SimError) -> PyErr {
         | SimError::MissingFile { .. }
         | SimError::MalformedUrdf { .. }
         | SimError::UnsupportedJointType { .. }
-        | SimError::UnsupportedGeometry { .. }
+        | SimError::Mesh { .. }
         | SimError::UnknownJoint { .. }
         | SimError::UnknownLink { .. }
         | SimError::InvalidJointParameter { .. }

@@ -9,6 +9,7 @@ mod gp;
 mod kinematics;
 mod runner;
 mod task;
+mod urdf;
 mod world;
 
 use pyo3::prelude::*;
@@ -37,6 +38,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(task::learner_values, m)?)?;
     m.add_function(wrap_pyfunction!(task::task_schema, m)?)?;
     m.add_function(wrap_pyfunction!(task::end_reasons, m)?)?;
+    m.add_function(wrap_pyfunction!(urdf::urdf_info, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

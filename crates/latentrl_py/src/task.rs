@@ -97,22 +97,10 @@ impl PyTask {
             .collect()
     }
 
-    /// Every collision shape: dicts `{link, kind, size, origin}` (origin: the pose in the link's
-    /// frame, position and quaternion x, y, z, w), to draw the robot.
+    /// Every collision shape as a dict (`urdf_info`'s shapes), to draw the robot.
     fn collision_shapes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let names = self.inner.model().link_names();
-        let out = PyList::empty(py);
-        for s in self.inner.model().collision_shapes() {
-            let d = PyDict::new(py);
-            d.set_item("link", names[s.link])?;
-            d.set_item("kind", s.kind)?;
-            d.set_item("size", s.size)?;
-            let t = s.origin.translation.vector;
-            let q = s.origin.rotation.coords;
-            d.set_item("origin", vec![t.x, t.y, t.z, q.x, q.y, q.z, q.w])?;
-            out.append(d)?;
-        }
-        Ok(out)
+        let model = self.inner.model();
+        crate::urdf::shape_list(py, &model.collision_shapes(), &model.link_names())
     }
 
     /// The names of the task's effectors.

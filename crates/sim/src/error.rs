@@ -54,14 +54,17 @@ pub enum SimError {
         /// Where the document came from.
         origin: String,
     },
-    /// A URDF link uses a geometry the loader cannot build (meshes need cargo features).
-    #[error("unsupported {kind} geometry in link {link:?} of {origin}: use box, cylinder, capsule or sphere")]
-    UnsupportedGeometry {
+    /// A collision mesh could not be used: missing, unreadable, malformed or flat.
+    #[error("collision mesh of link {link:?} in {origin}: {path}: {reason}")]
+    Mesh {
         /// The link's name.
         link: String,
-        /// The geometry kind, e.g. `"mesh"`.
-        kind: &'static str,
-        /// Where the document came from.
+        /// The file tried (after resolving `package://` and relative paths), or the
+        /// filename as written when it could not be resolved.
+        path: String,
+        /// What was wrong.
+        reason: String,
+        /// Where the URDF came from.
         origin: String,
     },
     /// A joint name that the robot does not have.

@@ -92,15 +92,20 @@ impl Task {
                 link(format!("constraints[{i}].link"), l)?;
             }
         }
+        for (i, pair) in config.physics.ignore_collisions.iter().enumerate() {
+            for (j, l) in pair.iter().enumerate() {
+                link(format!("physics.ignore_collisions[{i}][{j}]"), l)?;
+            }
+        }
         if let Some(fall) = &config.fall {
             for (i, s) in fall.soles.iter().enumerate() {
                 link(format!("fall.soles[{i}]"), s)?;
             }
         }
-        if let Some(name) = config.servo.joints.keys().find(|n| model.joint_index(n).is_err()) {
+        if let Some(name) = config.servo.joints.keys().find(|n| !model.is_servoed(n)) {
             return Err(failed(format!(
-                "servo.joints.{name}: no actuated joint of that name; actuated joints are: {}",
-                model.joint_names().join(", ")
+                "servo.joints.{name}: no servoed joint of that name; servoed joints are: {}",
+                model.servoed_names().join(", ")
             )));
         }
         Ok(Self {

@@ -2,8 +2,9 @@
 //!
 //! [`UrdfModel`] parses a file or a string (with the `urdf-rs` version that
 //! rapier3d-urdf 0.36.1 re-exports), rejects what the physics plant cannot simulate,
-//! and lists the actuated joints in URDF order. [`crate::world::World`] then inserts
-//! it into a rapier world as one multibody (reduced coordinates).
+//! loads its collision meshes as convex hulls ([`mesh`]) and lists the actuated joints in
+//! URDF order. [`crate::world::World`] then inserts it into a rapier world as one multibody
+//! (reduced coordinates). docs/robots.md lists what is supported.
 //!
 //! What rapier3d-urdf 0.36.1 ignores, and what we do about it:
 //! - `<dynamics damping friction>`: read here ([`JointInfo::damping`], [`JointInfo::friction`])
@@ -11,26 +12,31 @@
 //! - `limit.effort`: read here ([`JointInfo::effort`]) and used as the PD torque cap
 //!   (see [`crate::world::ServoConfig::use_urdf_effort`]).
 //! - `limit.velocity`: read ([`JointInfo::velocity`]) but **not enforced**.
-//! - `<mimic>`, `<safety_controller>`: rejected (mimic) or ignored (safety controller).
-//! - `<visual>`: ignored; only `<collision>` shapes become colliders. Meshes need cargo
-//!   features we do not enable, so a mesh collision shape is rejected.
+//! - `<mimic>`: the follower is not a coordinate of postures; its own servo tracks
+//!   `multiplier · q_leader + offset` of the leader's current position every physics step
+//!   ([`MimicInfo`]). `<safety_controller>`: ignored.
+//! - Mesh collision shapes: read here (STL, OBJ, COLLADA), one convex hull each, cached.
+//! - `<visual>`: not in the physics; [`UrdfModel::visual_shapes`] lists them for drawing.
 //!
 //! Supported joint types: `revolute`, `continuous`, `prismatic` (actuated, one DoF each)
 //! and `fixed`. `floating`, `planar` and `spherical` joints are rejected; a free-floating
 //! robot gets its 6 root DoF from [`RootMode::Floating`] instead.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use latent_core::choice;
 use rapier3d_urdf::urdf_rs;
 
 use crate::error::{Result, SimError};
 
+pub mod cache;
 mod check;
 mod insert;
+pub mod mesh;
 pub use check::{MAX_URDF_DEPTH, MAX_URDF_LINKS};
 use check::{check_joint_types, check_robot, check_size};
 pub(crate) use insert::JointSlot;
+use mesh::MeshHull;
 
 choice! {
     /// How the root link of the robot is attached to the world.
@@ -84,8 +90,29 @@ pub struct JointInfo {
     pub friction: Option<f64>,
 }
 
-/// One collision shape of a link, as the URDF gives it (for drawing; the physics builds its
-/// colliders from the same elements).
+/// A joint coupled to another (`<mimic>`): not a coordinate of postures, its servo follows
+/// `multiplier · q_leader + offset`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MimicInfo {
+    /// The coupled joint as written (its limits clamp the coupled target).
+    pub joint: JointInfo,
+    /// Index of the actuated joint it follows (the end of a chain of mimics).
+    pub leader: usize,
+    /// Multiplier of the leader's position (composed along a chain).
+    pub multiplier: f64,
+    /// Offset added (rad or m, composed along a chain).
+    pub offset: f64,
+}
+
+impl MimicInfo {
+    /// The coupled position for leader position `q`, clamped to the joint's limits.
+    pub fn follow(&self, q: f64) -> f64 {
+        (self.multiplier * q + self.offset).clamp(self.joint.lower, self.joint.upper)
+    }
+}
+
+/// One collision or visual shape of a link, as the URDF gives it (for drawing and
+/// `latentrl urdf-info`; the physics builds its colliders from the collision ones).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShapeInfo {
     /// Index of the link (URDF order).
@@ -97,6 +124,11 @@ pub struct ShapeInfo {
     pub size: Vec<f64>,
     /// Pose of the shape in its link's frame.
     pub origin: nalgebra::Isometry3<f64>,
+    /// A mesh's file as resolved (the filename as written if it could not be), else `None`.
+    pub file: Option<String>,
+    /// A collision mesh's triangles in the file and vertices of its hull, and whether the
+    /// hull came from the cache; `None` for primitives and visual shapes.
+    pub hull: Option<(usize, usize, bool)>,
 }
 
 /// A parsed and checked URDF robot.
@@ -104,7 +136,11 @@ pub struct ShapeInfo {
 pub struct UrdfModel {
     pub(crate) robot: urdf_rs::Robot,
     pub(crate) origin: String,
+    folder: PathBuf,
     joints: Vec<JointInfo>,
+    mimics: Vec<MimicInfo>,
+    /// `(link, collision element)` → its hull, for every mesh collision shape.
+    pub(crate) hulls: Vec<((usize, usize), MeshHull)>,
 }
 
 impl UrdfModel {
@@ -113,46 +149,94 @@ impl UrdfModel {
     /// Fails with [`SimError::MissingFile`] if it cannot be read, and otherwise as
     /// [`UrdfModel::parse_named`].
     pub fn from_file(path: impl AsRef<Path>) -> Result<Self> {
+        Self::from_file_with_cache(path, cache::default_folder().as_deref())
+    }
+
+    /// [`UrdfModel::from_file`] with the mesh hull cache in `cache` (`None`: no cache).
+    pub fn from_file_with_cache(path: impl AsRef<Path>, cache: Option<&Path>) -> Result<Self> {
         let path = path.as_ref();
         let origin = path.display().to_string();
         let xml = std::fs::read_to_string(path).map_err(|e| SimError::MissingFile {
             path: origin.clone(),
             reason: e.to_string(),
         })?;
-        Self::parse_named(&xml, &origin)
+        let parent = path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let folder = std::fs::canonicalize(parent).unwrap_or_else(|_| parent.to_path_buf());
+        Self::parse_with(&xml, &origin, &folder, cache)
     }
 
-    /// Parses and checks a URDF document held in a string.
+    /// Parses and checks a URDF document held in a string (mesh paths relative to the
+    /// current folder).
     pub fn parse(xml: &str) -> Result<Self> {
-        Self::parse_named(xml, "<string>")
+        Self::parse_named(xml, "<string>", Path::new("."))
     }
 
-    /// Parses and checks a URDF document; `origin` names it in error messages.
+    /// Parses and checks a URDF document as [`UrdfModel::parse_with`], with the default hull
+    /// cache ([`cache::default_folder`]).
+    pub fn parse_named(xml: &str, origin: &str, folder: &Path) -> Result<Self> {
+        Self::parse_with(xml, origin, folder, cache::default_folder().as_deref())
+    }
+
+    /// Parses and checks a URDF document; `origin` names it in error messages, mesh files are
+    /// found from `folder` ([`mesh::resolve`]) and their hulls cached in `cache`.
     ///
     /// Errors: [`SimError::UnsupportedJointType`] for a joint type other than revolute,
-    /// continuous, prismatic or fixed (including unknown type strings) or a mimic joint;
+    /// continuous, prismatic or fixed (including unknown type strings);
     /// [`SimError::MalformedUrdf`] for bad XML, duplicate names, joints naming missing links,
+    /// a mimic joint naming no moving joint or in a cycle of mimics,
     /// a link with two parents, empty or non-finite limits, a moving link without mass, a
     /// link with mass whose inertia tensor is not positive definite, breaks the triangle
     /// inequality or has a radius of gyration outside [1 µm, 1 km], non-finite inertial or
     /// collision poses, negative or non-finite collision sizes, a zero axis, a length or joint
     /// limit beyond ±1000 (m or rad), or a number too large for rapier's f32 (|value| > 3.4e38);
-    /// [`SimError::UnsupportedGeometry`] for mesh collision shapes. A document nested deeper
+    /// [`SimError::Mesh`] for a collision mesh that cannot be found, read or hulled
+    /// ([`mesh::load_hull`]). A document nested deeper
     /// than [`MAX_URDF_DEPTH`] or with more than [`MAX_URDF_LINKS`] links is refused as
     /// malformed before it is parsed.
-    pub fn parse_named(xml: &str, origin: &str) -> Result<Self> {
+    pub fn parse_with(xml: &str, origin: &str, folder: &Path, cache: Option<&Path>) -> Result<Self> {
         check_size(xml, origin)?;
         check_joint_types(xml, origin)?;
         let robot = urdf_rs::read_from_string(xml).map_err(|e| SimError::MalformedUrdf {
             origin: origin.to_string(),
             reason: e.to_string(),
         })?;
-        let joints = check_robot(&robot, origin)?;
-        Ok(Self {
+        let (joints, mimics) = check_robot(&robot, origin)?;
+        let mut model = Self {
             robot,
             origin: origin.to_string(),
+            folder: folder.to_path_buf(),
             joints,
-        })
+            mimics,
+            hulls: Vec::new(),
+        };
+        model.hulls = model.load_hulls(cache)?;
+        Ok(model)
+    }
+
+    /// The convex hull of every mesh collision shape ([`mesh::load_hull`]).
+    fn load_hulls(&self, cache: Option<&Path>) -> Result<Vec<((usize, usize), MeshHull)>> {
+        let mut out = Vec::new();
+        for (l, link) in self.robot.links.iter().enumerate() {
+            for (c, collision) in link.collision.iter().enumerate() {
+                let urdf_rs::Geometry::Mesh { filename, scale } = &collision.geometry else {
+                    continue;
+                };
+                let failed = |path: String, reason: String| SimError::Mesh {
+                    link: link.name.clone(),
+                    path,
+                    reason,
+                    origin: self.origin.clone(),
+                };
+                let path = mesh::resolve(filename, &self.folder).map_err(|e| failed(filename.clone(), e))?;
+                let scale = scale.map_or([1.0; 3], |s| s.0);
+                let hull = mesh::load_hull(&path, scale, cache).map_err(|e| failed(path.display().to_string(), e))?;
+                out.push(((l, c), hull));
+            }
+        }
+        Ok(out)
     }
 
     /// The robot's name attribute.
@@ -163,6 +247,27 @@ impl UrdfModel {
     /// The actuated joints, in URDF order (the order of postures and targets).
     pub fn joints(&self) -> &[JointInfo] {
         &self.joints
+    }
+
+    /// The mimic joints, in URDF order: each follows an actuated joint.
+    pub fn mimics(&self) -> &[MimicInfo] {
+        &self.mimics
+    }
+
+    /// Whether `name` is a joint with a servo (actuated or mimic): what `servo.joints` may name.
+    pub fn is_servoed(&self, name: &str) -> bool {
+        self.joint_index(name).is_ok() || self.mimics.iter().any(|m| m.joint.name == name)
+    }
+
+    /// Names of the joints with a servo: the actuated ones, then the mimic ones.
+    pub fn servoed_names(&self) -> Vec<&str> {
+        let mimics = self.mimics.iter().map(|m| m.joint.name.as_str());
+        self.joint_names().into_iter().chain(mimics).collect()
+    }
+
+    /// Total mass of the robot's links (kg).
+    pub fn total_mass(&self) -> f64 {
+        self.robot.links.iter().map(|l| l.inertial.mass.value).sum()
     }
 
     /// Names of the actuated joints, in URDF order.
@@ -189,24 +294,55 @@ impl UrdfModel {
     /// Every collision shape, link by link in URDF order.
     pub fn collision_shapes(&self) -> Vec<ShapeInfo> {
         let mut out = Vec::new();
-        for (link, l) in self.robot.links.iter().enumerate() {
-            for c in &l.collision {
-                let (kind, size) = match &c.geometry {
-                    urdf_rs::Geometry::Box { size } => ("box", size.0.to_vec()),
-                    urdf_rs::Geometry::Sphere { radius } => ("sphere", vec![*radius]),
-                    urdf_rs::Geometry::Cylinder { radius, length } => ("cylinder", vec![*radius, *length]),
-                    urdf_rs::Geometry::Capsule { radius, length } => ("capsule", vec![*radius, *length]),
-                    urdf_rs::Geometry::Mesh { scale, .. } => ("mesh", scale.map_or(vec![1.0; 3], |s| s.0.to_vec())),
-                };
-                out.push(ShapeInfo {
-                    link,
-                    kind,
-                    size,
-                    origin: crate::pose::origin_pose(&c.origin),
-                });
+        for (l, link) in self.robot.links.iter().enumerate() {
+            for (c, collision) in link.collision.iter().enumerate() {
+                let hull = self.hulls.iter().find(|(at, _)| *at == (l, c)).map(|(_, h)| h);
+                let mut info = self.shape(l, &collision.geometry, &collision.origin);
+                if let Some(h) = hull {
+                    info.file = Some(h.path.display().to_string());
+                    info.hull = Some((h.source_triangles, h.points.len(), h.cached));
+                }
+                out.push(info);
             }
         }
         out
+    }
+
+    /// `(link, hull vertices)` of every mesh collision shape, in URDF order: what the physics
+    /// collides with.
+    pub fn hull_points(&self) -> Vec<(usize, Vec<[f32; 3]>)> {
+        self.hulls.iter().map(|((l, _), h)| (*l, h.points.clone())).collect()
+    }
+
+    /// Every visual shape, link by link in URDF order (not in the physics; to draw the robot).
+    pub fn visual_shapes(&self) -> Vec<ShapeInfo> {
+        let mut out = Vec::new();
+        for (l, link) in self.robot.links.iter().enumerate() {
+            out.extend(link.visual.iter().map(|v| self.shape(l, &v.geometry, &v.origin)));
+        }
+        out
+    }
+
+    /// A shape of link `link` as [`ShapeInfo`] (a mesh's file resolved where possible).
+    fn shape(&self, link: usize, geometry: &urdf_rs::Geometry, origin: &urdf_rs::Pose) -> ShapeInfo {
+        let (kind, size, file) = match geometry {
+            urdf_rs::Geometry::Box { size } => ("box", size.0.to_vec(), None),
+            urdf_rs::Geometry::Sphere { radius } => ("sphere", vec![*radius], None),
+            urdf_rs::Geometry::Cylinder { radius, length } => ("cylinder", vec![*radius, *length], None),
+            urdf_rs::Geometry::Capsule { radius, length } => ("capsule", vec![*radius, *length], None),
+            urdf_rs::Geometry::Mesh { filename, scale } => {
+                let file = mesh::resolve(filename, &self.folder).map_or(filename.clone(), |p| p.display().to_string());
+                ("mesh", scale.map_or(vec![1.0; 3], |s| s.0.to_vec()), Some(file))
+            }
+        };
+        ShapeInfo {
+            link,
+            kind,
+            size,
+            origin: crate::pose::origin_pose(origin),
+            file,
+            hull: None,
+        }
     }
 
     /// `(parent link, child link)` of every URDF joint, fixed ones included: the kinematic

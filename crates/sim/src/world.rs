@@ -20,6 +20,7 @@ use crate::shapes::Obstacle;
 use crate::urdf::{JointSlot, RootMode, UrdfModel};
 
 mod config;
+mod filter;
 mod readout;
 mod snapshot;
 pub use config::{JointServo, PhysicsConfig, ServoConfig, WorldConfig};
@@ -40,6 +41,9 @@ pub struct World {
     pub(crate) config: WorldConfig,
     pub(crate) slots: Vec<JointSlot>,
     pub(crate) gains: Vec<PdGains>,
+    /// The mimic joints' slots and servo gains, in the order of [`UrdfModel::mimics`].
+    pub(crate) mimic_slots: Vec<JointSlot>,
+    pub(crate) mimic_gains: Vec<PdGains>,
     pub(crate) targets: Vec<f64>,
     pub(crate) frames: Vec<Option<(RigidBodyHandle, Isometry3<f64>)>>,
     pub(crate) link_colliders: Vec<(usize, ColliderHandle)>,
@@ -47,6 +51,7 @@ pub struct World {
     pub(crate) ground: Option<ColliderHandle>,
     pub(crate) obstacles: Vec<ObstacleEntry>,
     pub(crate) time: f64,
+    filter: filter::PairFilter,
 }
 
 impl World {
@@ -55,10 +60,10 @@ impl World {
     /// per-joint servo naming no actuated joint.
     pub fn new(model: UrdfModel, config: WorldConfig) -> Result<Self> {
         config.validate()?;
-        if let Some(name) = config.servo.joints.keys().find(|n| model.joint_index(n).is_err()) {
+        if let Some(name) = config.servo.joints.keys().find(|n| !model.is_servoed(n)) {
             return Err(SimError::UnknownJoint {
                 name: format!("servo.joints.{name}"),
-                known: model.joint_names().join(", "),
+                known: model.servoed_names().join(", "),
             });
         }
         let physics = &config.physics;
@@ -82,6 +87,23 @@ impl World {
                 mb.frictions_mut()[slot.dof] = info.friction.unwrap_or(0.0) as Real;
             }
         }
+        let mut ignored = Vec::with_capacity(physics.ignore_collisions.len());
+        for (i, pair) in physics.ignore_collisions.iter().enumerate() {
+            let mut at = [0; 2];
+            for (k, name) in pair.iter().enumerate() {
+                at[k] = model.link_index(name).map_err(|_| SimError::UnknownLink {
+                    name: format!("physics.ignore_collisions[{i}][{k}] = {name:?}"),
+                    known: model.link_names().join(", "),
+                })?;
+            }
+            ignored.push((at[0], at[1]));
+        }
+        let filter = filter::PairFilter::new(&ignored, &robot.colliders, &mut world.colliders);
+        let mimic_gains: Vec<PdGains> = model
+            .mimics()
+            .iter()
+            .map(|m| config.servo.gains(&m.joint.name, m.joint.effort))
+            .collect();
         let n = model.joints().len();
         let start: Vec<f64> = model.joints().iter().map(|j| 0.0_f64.clamp(j.lower, j.upper)).collect();
         let mut sim = Self {
@@ -90,6 +112,8 @@ impl World {
             config,
             slots: robot.slots,
             gains,
+            mimic_slots: robot.mimic_slots,
+            mimic_gains,
             targets: vec![0.0; n],
             frames: robot.frames,
             link_colliders: robot.colliders,
@@ -97,6 +121,7 @@ impl World {
             ground,
             obstacles: Vec::new(),
             time: 0.0,
+            filter,
         };
         sim.reset(&start)?;
         Ok(sim)
@@ -191,7 +216,14 @@ impl World {
         if floating && let Some(rb) = self.world.bodies.get_mut(self.root) {
             rb.set_position(to_pose(base), true);
         }
-        for (slot, &q) in self.slots.iter().zip(posture) {
+        let coupled: Vec<f64> = self
+            .model
+            .mimics()
+            .iter()
+            .map(|m| m.follow(posture[m.leader]))
+            .collect();
+        let all_slots = self.slots.iter().chain(&self.mimic_slots);
+        for (slot, &q) in all_slots.clone().zip(posture.iter().chain(&coupled)) {
             if let Some((mb, _)) = self.world.multibody_joints.get_mut(slot.handle)
                 && let Some(link) = mb.link_mut(slot.link_id)
             {
@@ -213,11 +245,12 @@ impl World {
             rb.set_linvel(Vector::ZERO, true);
             rb.set_angvel(Vector::ZERO, true);
         }
-        for (i, slot) in self.slots.iter().enumerate() {
+        let all_gains = self.gains.iter().chain(&self.mimic_gains);
+        for ((slot, &q), gains) in all_slots.zip(posture.iter().chain(&coupled)).zip(all_gains) {
             if let Some((mb, _)) = self.world.multibody_joints.get_mut(slot.handle)
                 && let Some(link) = mb.link_mut(slot.link_id)
             {
-                drive(&mut link.joint.data, slot.axis, posture[i], &self.gains[i]);
+                drive(&mut link.joint.data, slot.axis, q, gains);
             }
         }
         self.targets.copy_from_slice(posture);
@@ -277,12 +310,30 @@ impl World {
         Ok(())
     }
 
-    /// Advances the world by `n` physics steps of `dt`.
+    /// Advances the world by `n` physics steps of `dt`; before each, the mimic joints' servos
+    /// are aimed at their leaders' positions.
     pub fn step(&mut self, n: usize) {
         for _ in 0..n {
-            self.world.step();
+            self.couple_mimics();
+            if self.filter.is_empty() {
+                self.world.step();
+            } else {
+                self.world.step_with_events(&self.filter, &());
+            }
         }
         self.time += n as f64 * self.config.physics.dt;
+    }
+
+    /// Aims each mimic joint's servo at `multiplier · q_leader + offset` of its leader now.
+    fn couple_mimics(&mut self) {
+        for (m, slot) in self.model.mimics().iter().zip(&self.mimic_slots) {
+            let q = self.coordinate(&self.slots[m.leader]);
+            if let Some((mb, _)) = self.world.multibody_joints.get_mut(slot.handle)
+                && let Some(link) = mb.link_mut(slot.link_id)
+            {
+                retarget(&mut link.joint.data, slot.axis, m.follow(q));
+            }
+        }
     }
 
     /// Advances the world by one RL step (`substeps` physics steps).

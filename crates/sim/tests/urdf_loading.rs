@@ -103,11 +103,11 @@ fn structural_errors_are_malformed_urdf() {
 }
 
 #[test]
-fn mesh_collision_is_unsupported_geometry() {
+fn missing_mesh_names_its_link_and_the_path_tried() {
     let mesh = r#"<link name="m"><collision><geometry><mesh filename="a.stl"/></geometry></collision></link>"#;
     let err = UrdfModel::parse(&robot(&format!("{HINGE}{mesh}"))).unwrap_err();
     assert!(
-        matches!(&err, SimError::UnsupportedGeometry { link, .. } if link == "m"),
+        matches!(&err, SimError::Mesh { link, path, .. } if link == "m" && path.ends_with("a.stl")),
         "{err}"
     );
 }

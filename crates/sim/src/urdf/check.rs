@@ -1,12 +1,12 @@
 //! Checks on a URDF that the loader does not make: it would panic (a joint naming a
-//! missing link), drop things silently (meshes, mimic) or fail with an opaque XML error
+//! missing link), ignore silently (mimic couplings) or fail with an opaque XML error
 //! (an unknown joint type).
 
 use std::collections::HashSet;
 
 use rapier3d_urdf::urdf_rs;
 
-use super::{JointInfo, JointKind};
+use super::{JointInfo, JointKind, MimicInfo};
 use crate::error::{Result, SimError};
 
 /// Removes `<!-- … -->` comments so the joint-type scan does not read commented-out XML.
@@ -122,7 +122,9 @@ pub(super) fn check_joint_types(xml: &str, origin: &str) -> Result<()> {
 }
 
 /// Structural checks the loader does not make (it would panic or silently drop things).
-pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<JointInfo>> {
+///
+/// Returns the actuated joints and the mimic joints (each coupled to an actuated leader).
+pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<(Vec<JointInfo>, Vec<MimicInfo>)> {
     let bad = |reason: String| SimError::MalformedUrdf {
         origin: origin.to_string(),
         reason,
@@ -131,16 +133,6 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
     for link in &robot.links {
         if !names.insert(link.name.as_str()) {
             return Err(bad(format!("duplicate link name {:?}", link.name)));
-        }
-        for c in &link.collision {
-            if matches!(c.geometry, urdf_rs::Geometry::Mesh { .. }) {
-                let link = link.name.clone();
-                return Err(SimError::UnsupportedGeometry {
-                    link,
-                    kind: "mesh",
-                    origin: origin.to_string(),
-                });
-            }
         }
         let i = &link.inertial;
         let values = [
@@ -175,6 +167,7 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
     let mut joint_names = HashSet::new();
     let mut children = HashSet::new();
     let mut actuated = Vec::new();
+    let mut followers = Vec::new();
     for joint in &robot.joints {
         if !joint_names.insert(joint.name.as_str()) {
             return Err(bad(format!("duplicate joint name {:?}", joint.name)));
@@ -189,13 +182,6 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
         }
         if !children.insert(joint.child.link.as_str()) {
             return Err(bad(format!("link {:?} is the child of two joints", joint.child.link)));
-        }
-        if joint.mimic.is_some() {
-            return Err(SimError::UnsupportedJointType {
-                joint: joint.name.clone(),
-                kind: "mimic".to_string(),
-                origin: origin.to_string(),
-            });
         }
         let owner = format!("joint {:?}", joint.name);
         check_magnitudes(&owner, joint_numbers(joint)).map_err(bad)?;
@@ -244,7 +230,7 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
         }
         let positive = |v: f64| (v.is_finite() && v > 0.0).then_some(v);
         let dynamics = joint.dynamics.as_ref();
-        actuated.push(JointInfo {
+        let info = JointInfo {
             name: joint.name.clone(),
             kind,
             child_link: joint.child.link.clone(),
@@ -254,9 +240,66 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<Vec<Jo
             velocity: positive(joint.limit.velocity),
             damping: dynamics.map(|d| d.damping).filter(|v| v.is_finite() && *v >= 0.0),
             friction: dynamics.map(|d| d.friction).filter(|v| v.is_finite() && *v >= 0.0),
+        };
+        match &joint.mimic {
+            Some(mimic) => followers.push((info, mimic)),
+            None => actuated.push(info),
+        }
+    }
+    let mimics = couple(&actuated, &followers).map_err(bad)?;
+    Ok((actuated, mimics))
+}
+
+/// Resolves every mimic joint to the actuated joint at the end of its chain of leaders
+/// (`q = multiplier · q_leader + offset`, composed along the chain).
+fn couple(
+    actuated: &[JointInfo],
+    followers: &[(JointInfo, &urdf_rs::Mimic)],
+) -> std::result::Result<Vec<MimicInfo>, String> {
+    let mut out = Vec::with_capacity(followers.len());
+    for (info, mimic) in followers {
+        let (mut multiplier, mut offset) = (1.0, 0.0);
+        let mut chain = vec![info.name.as_str()];
+        let mut next = *mimic;
+        let leader = loop {
+            let m = next.multiplier.unwrap_or(1.0);
+            let o = next.offset.unwrap_or(0.0);
+            if !(m.is_finite() && o.is_finite() && m.abs() <= LENGTH_MAX && o.abs() <= LENGTH_MAX) {
+                return Err(format!(
+                    "joint {:?} has <mimic multiplier={m} offset={o}>: both must be finite, within ±{LENGTH_MAX}",
+                    chain[chain.len() - 1]
+                ));
+            }
+            (multiplier, offset) = (multiplier * m, multiplier * o + offset);
+            let name = next.joint.as_str();
+            if chain.contains(&name) {
+                chain.push(name);
+                return Err(format!("mimic joints form a cycle: {}", chain.join(" -> ")));
+            }
+            if let Some(i) = actuated.iter().position(|j| j.name == name) {
+                break i;
+            }
+            match followers.iter().find(|(f, _)| f.name == name) {
+                Some((_, m)) => {
+                    chain.push(name);
+                    next = m;
+                }
+                None => {
+                    return Err(format!(
+                        "joint {:?} mimics joint {name:?}, which is not a moving joint of the robot",
+                        chain[chain.len() - 1]
+                    ));
+                }
+            }
+        };
+        out.push(MimicInfo {
+            joint: info.clone(),
+            leader,
+            multiplier,
+            offset,
         });
     }
-    Ok(actuated)
+    Ok(out)
 }
 
 /// Largest magnitude rapier's f32 holds: a larger finite f64 becomes ±inf in the physics.
@@ -349,7 +392,9 @@ fn geometry_sizes(g: &urdf_rs::Geometry) -> Vec<(&'static str, f64)> {
             vec![("radius", *radius), ("length", *length)]
         }
         urdf_rs::Geometry::Sphere { radius } => vec![("radius", *radius)],
-        urdf_rs::Geometry::Mesh { .. } => Vec::new(),
+        urdf_rs::Geometry::Mesh { scale, .. } => {
+            scale.map_or(Vec::new(), |s| s.0.map(|v| ("mesh scale", v.abs())).to_vec())
+        }
     }
 }
 

@@ -7,11 +7,11 @@ use nalgebra::Isometry3;
 use rapier3d::prelude::{
     ColliderHandle, JointAxis, MultibodyJointHandle, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle,
 };
-use rapier3d_urdf::{UrdfLoaderOptions, UrdfMultibodyOptions, UrdfRobot, urdf_rs};
+use rapier3d_urdf::{UrdfCollider, UrdfLoaderOptions, UrdfMultibodyOptions, UrdfRobot, urdf_rs};
 
-use super::{JointKind, RootMode, UrdfModel};
+use super::{JointInfo, JointKind, RootMode, UrdfModel};
 use crate::error::{Result, SimError};
-use crate::pose::origin_pose;
+use crate::pose::{origin_pose, to_pose};
 
 /// Where one actuated joint lives inside the rapier multibody.
 #[derive(Debug, Clone, Copy)]
@@ -30,6 +30,8 @@ pub(crate) struct JointSlot {
 pub(crate) struct InsertedRobot {
     /// One slot per actuated joint, in URDF order.
     pub slots: Vec<JointSlot>,
+    /// One slot per mimic joint, in the order of [`UrdfModel::mimics`].
+    pub mimic_slots: Vec<JointSlot>,
     /// Per URDF link: the rigid body carrying it and the link frame in that body's frame
     /// (identity unless the loader folded a body-less link into its neighbour).
     pub frames: Vec<Option<(RigidBodyHandle, Isometry3<f64>)>>,
@@ -60,7 +62,9 @@ impl UrdfModel {
             rigid_body_blueprint: RigidBodyBuilder::dynamic().can_sleep(false),
             ..UrdfLoaderOptions::default()
         };
-        let robot = UrdfRobot::from_robot(&self.robot, options, Path::new("."));
+        let mut robot = UrdfRobot::from_robot(&self.without_meshes(), options.clone(), Path::new("."));
+        self.add_hull_colliders(&mut robot, &options)?;
+        self.anchor_squeezed_root(&mut robot);
         let link_ids: Vec<usize> = robot.links.iter().map(|l| l.urdf_link_index).collect();
         let joint_ids: Vec<(usize, Vec<usize>)> = robot
             .joints
@@ -88,8 +92,7 @@ impl UrdfModel {
         }
         self.resolve_folded_frames(&mut frames);
 
-        let mut slots = Vec::with_capacity(self.joints.len());
-        for info in &self.joints {
+        let mut slot = |info: &JointInfo| -> Result<JointSlot> {
             let urdf_joint = self.robot.joints.iter().position(|j| j.name == info.name);
             let k = joint_ids
                 .iter()
@@ -108,29 +111,112 @@ impl UrdfModel {
                 _ => JointAxis::AngX,
             };
             let dof = mb.link(link_id).map_or(0, |l| l.assembly_id());
-            slots.push(JointSlot {
+            Ok(JointSlot {
                 handle,
                 link_id,
                 dof,
                 axis,
-            });
-        }
-        let parentless = (0..n_links).find(|&i| {
-            !self
-                .robot
-                .joints
-                .iter()
-                .any(|j| j.child.link == self.robot.links[i].name)
-        });
-        let root = parentless
+            })
+        };
+        let slots = self.joints.iter().map(&mut slot).collect::<Result<Vec<_>>>()?;
+        let mimic_slots = self.mimics.iter().map(|m| slot(&m.joint)).collect::<Result<Vec<_>>>()?;
+        let root = self
+            .root_link()
             .and_then(|i| frames[i])
             .map(|(body, _)| body)
             .ok_or_else(|| bad("the robot has no root link".to_string()))?;
         Ok(InsertedRobot {
             slots,
+            mimic_slots,
             frames,
             colliders,
             root,
+        })
+    }
+
+    /// The robot with every mesh collision shape replaced by an empty box, which the loader
+    /// skips: the meshes become colliders from their hulls ([`Self::add_hull_colliders`]),
+    /// while each link keeps its `<collision>` elements (so none is dropped as empty).
+    fn without_meshes(&self) -> urdf_rs::Robot {
+        let mut robot = self.robot.clone();
+        for collision in robot.links.iter_mut().flat_map(|l| l.collision.iter_mut()) {
+            if matches!(collision.geometry, urdf_rs::Geometry::Mesh { .. }) {
+                collision.geometry = urdf_rs::Geometry::Box {
+                    size: urdf_rs::Vec3([0.0; 3]),
+                };
+            }
+        }
+        robot
+    }
+
+    /// Adds a collider for each mesh hull to the loaded link that carries its URDF link.
+    fn add_hull_colliders(&self, robot: &mut UrdfRobot, options: &UrdfLoaderOptions) -> Result<()> {
+        for ((l, c), hull) in &self.hulls {
+            let link = &self.robot.links[*l];
+            let failed = |reason: &str| SimError::Mesh {
+                link: link.name.clone(),
+                path: hull.path.display().to_string(),
+                reason: reason.to_string(),
+                origin: self.origin.clone(),
+            };
+            let shape = hull.shape().ok_or_else(|| failed("its hull has no volume"))?;
+            let body = robot
+                .links
+                .iter_mut()
+                .find(|b| b.urdf_link_index == *l)
+                .ok_or_else(|| failed("its link was not made a body"))?;
+            let mut builder = options.collider_blueprint.clone();
+            builder.shape = shape;
+            let collider = builder
+                .position(to_pose(&origin_pose(&link.collision[*c].origin)))
+                .build();
+            body.colliders.push(UrdfCollider { collider, visual: None });
+        }
+        Ok(())
+    }
+
+    /// Puts back the pose of the links an empty root link was fixed to: rapier3d-urdf 0.36.1
+    /// drops such a root (a `world` or `base` frame) and anchors its fixed children at the
+    /// world origin, losing the fixed joint's `<origin>` (a Kinova arm's base yaw of 90° turned
+    /// the whole arm). Each such child's subtree is moved by that origin, so the URDF root stays
+    /// at the world origin as the URDF says.
+    fn anchor_squeezed_root(&self, robot: &mut UrdfRobot) {
+        let Some(root) = self.root_link() else { return };
+        if robot.links.iter().any(|l| l.urdf_link_index == root) {
+            return;
+        }
+        let root_name = &self.robot.links[root].name;
+        for joint in self.robot.joints.iter().filter(|j| &j.parent.link == root_name) {
+            let origin = origin_pose(&joint.origin);
+            let child = self.robot.links.iter().position(|l| l.name == joint.child.link);
+            let start = robot.links.iter().position(|l| Some(l.urdf_link_index) == child);
+            let (Some(start), false) = (start, origin == Isometry3::identity()) else {
+                continue;
+            };
+            let mut subtree = vec![start];
+            let mut k = 0;
+            while k < subtree.len() {
+                let parent = subtree[k];
+                subtree.extend(robot.joints.iter().filter(|j| j.link1 == parent).map(|j| j.link2));
+                k += 1;
+            }
+            let shift = to_pose(&origin);
+            for i in subtree {
+                let body = &mut robot.links[i].body;
+                let moved = shift * body.position();
+                body.set_position(moved, true);
+            }
+        }
+    }
+
+    /// The URDF link no joint moves (the first one, if the description has several).
+    fn root_link(&self) -> Option<usize> {
+        (0..self.robot.links.len()).find(|&i| {
+            !self
+                .robot
+                .joints
+                .iter()
+                .any(|j| j.child.link == self.robot.links[i].name)
         })
     }
 

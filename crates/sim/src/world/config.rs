@@ -29,6 +29,9 @@ params! {
         joint_damping: f64 = 0.0 => Rule::NonNegative,
         /// Let links of the robot collide with each other (adjacent links never do).
         self_collisions: bool = false => Rule::Any,
+        /// With self_collisions: pairs of links that still never collide, e.g.
+        /// [["link3", "link5"]] (a task may list what a robot's meshes make overlap).
+        ignore_collisions: Vec<[String; 2]> = Vec::new() => Rule::Any,
         /// Shapes closer than this (m) touch, for the obstacle and floor queries.
         contact_margin: f64 = 1e-3 => Rule::closed(0.0, 1.0),
     }

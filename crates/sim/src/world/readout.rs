@@ -20,12 +20,7 @@ impl World {
     /// Writes the joint positions (URDF order) into `out` (length `num_joints`).
     pub fn joint_positions_into(&self, out: &mut [f64]) {
         for (o, slot) in out.iter_mut().zip(&self.slots) {
-            *o = self
-                .world
-                .multibody_joints
-                .get(slot.handle)
-                .and_then(|(mb, _)| mb.link(slot.link_id))
-                .map_or(f64::NAN, |l| l.joint().coords()[slot.axis as usize] as f64);
+            *o = self.coordinate(slot);
         }
     }
 
@@ -34,6 +29,20 @@ impl World {
         let mut out = vec![0.0; self.slots.len()];
         self.joint_positions_into(&mut out);
         out
+    }
+
+    /// The mimic joints' positions, in the order of [`crate::UrdfModel::mimics`].
+    pub fn mimic_positions(&self) -> Vec<f64> {
+        self.mimic_slots.iter().map(|slot| self.coordinate(slot)).collect()
+    }
+
+    /// The coordinate of one joint slot (NaN if rapier lost it).
+    pub(crate) fn coordinate(&self, slot: &JointSlot) -> f64 {
+        self.world
+            .multibody_joints
+            .get(slot.handle)
+            .and_then(|(mb, _)| mb.link(slot.link_id))
+            .map_or(f64::NAN, |l| l.joint().coords()[slot.axis as usize] as f64)
     }
 
     /// The joint velocities (rad/s or m/s), URDF order.

@@ -1,0 +1,205 @@
+//! Collision meshes: finding a URDF `<mesh filename>`, reading it (STL, OBJ, COLLADA with
+//! the `mesh-loader` crate) and turning it into one convex hull (parry's quickhull).
+//!
+//! Why a convex hull and not the triangle mesh: a robot link is a moving body, and rapier
+//! finds contacts between two triangle meshes only at their surfaces (no volume: a link can
+//! end up inside an obstacle and stay there) and at many times the cost of a convex shape.
+//! One hull per mesh file is what MuJoCo does with every mesh geom; it fills concave parts
+//! (a gripper's gap), which a convex decomposition would keep, at more shapes per link.
+//!
+//! Hulls are cached on disk ([`super::cache`]) under the hash of the file's bytes and the
+//! scale, so a second load of the same robot reads a few hundred points per mesh instead of
+//! parsing the file. A hull is built from the same points and triangles either way, so the
+//! physics is bit-identical with or without the cache.
+
+use std::path::{Component, Path, PathBuf};
+
+use rapier3d::parry::transformation::try_convex_hull;
+use rapier3d::prelude::{SharedShape, Vector};
+
+use super::cache;
+
+/// The largest mesh file read (bytes): bounds the memory a malformed or huge mesh takes.
+pub const MAX_MESH_BYTES: u64 = 128 << 20;
+
+/// The most triangles a collision mesh may have: real collision meshes have a few thousand
+/// (a 7-DoF arm's 2k–10k per link); a million is a visual scan, to be simplified first.
+pub const MAX_MESH_TRIANGLES: usize = 500_000;
+
+/// A collision mesh turned into its convex hull.
+#[derive(Debug, Clone)]
+pub struct MeshHull {
+    /// The file the mesh was read from (after `package://` and relative paths were resolved).
+    pub path: PathBuf,
+    /// Triangles in the file (all its meshes).
+    pub source_triangles: usize,
+    /// Vertices of the hull (scaled, in the link's collision frame).
+    pub points: Vec<[f32; 3]>,
+    /// Triangles of the hull (indices into `points`).
+    pub triangles: Vec<[u32; 3]>,
+    /// Whether the hull came from the cache.
+    pub cached: bool,
+}
+
+impl MeshHull {
+    /// The collider shape: the convex polyhedron of [`MeshHull::points`].
+    pub(crate) fn shape(&self) -> Option<SharedShape> {
+        let points = self.points.iter().map(|p| Vector::new(p[0], p[1], p[2])).collect();
+        SharedShape::convex_mesh(points, &self.triangles)
+    }
+}
+
+/// The file a URDF mesh `filename` names, for a URDF in folder `urdf_dir`.
+///
+/// - `package://NAME/REST`: REST inside the package root, the nearest folder named NAME that
+///   is the URDF's folder or one of its ancestors, or a folder NAME inside one of those (the
+///   layout of a ROS description package, and of a URDF copied next to its package).
+///   REST may not leave the package root (`..`).
+/// - `file:///abs/path` and absolute paths: as written.
+/// - Anything else: relative to the URDF's folder.
+pub fn resolve(filename: &str, urdf_dir: &Path) -> Result<PathBuf, String> {
+    if let Some(rest) = filename.strip_prefix("package://") {
+        let (package, inner) = rest.split_once('/').unwrap_or((rest, ""));
+        if package.is_empty() || inner.is_empty() {
+            return Err("a package:// path needs a package name and a file: package://NAME/FILE".to_string());
+        }
+        let inside = Path::new(inner).components().all(|c| matches!(c, Component::Normal(_)));
+        if !inside {
+            return Err(format!(
+                "{filename:?} leaves its package folder: package paths may not contain '..' or start at '/'"
+            ));
+        }
+        let root = package_root(package, urdf_dir).ok_or_else(|| {
+            format!(
+                "no folder {package:?} is {} or one of its ancestors, or lies in one of them",
+                urdf_dir.display()
+            )
+        })?;
+        return Ok(root.join(inner));
+    }
+    let path = filename.strip_prefix("file://").unwrap_or(filename);
+    Ok(urdf_dir.join(path))
+}
+
+/// The root of package `name` as [`resolve`] finds it.
+fn package_root(name: &str, urdf_dir: &Path) -> Option<PathBuf> {
+    let start = std::path::absolute(urdf_dir).ok()?;
+    start.ancestors().find_map(|dir| {
+        if dir.file_name().is_some_and(|n| n == name) {
+            Some(dir.to_path_buf())
+        } else {
+            let inner = dir.join(name);
+            inner.is_dir().then_some(inner)
+        }
+    })
+}
+
+/// Reads the mesh at `path`, scales it and returns its convex hull (from the cache folder
+/// `cache` if given and the hull is there; stored there otherwise).
+///
+/// Errors (a sentence naming what was wrong; the caller adds the link and the path): a file
+/// that is missing, unreadable, larger than [`MAX_MESH_BYTES`] or not a mesh the readers
+/// know; a mesh without triangles, with more than [`MAX_MESH_TRIANGLES`], with a non-finite
+/// vertex, or flat (no volume: no hull).
+pub fn load_hull(path: &Path, scale: [f64; 3], cache: Option<&Path>) -> Result<MeshHull, String> {
+    let bytes = read_bounded(path)?;
+    let key = cache::key(&bytes, scale);
+    if let Some((points, triangles, source_triangles)) = cache.and_then(|dir| cache::read(dir, &key)) {
+        return Ok(MeshHull {
+            path: path.to_path_buf(),
+            source_triangles,
+            points,
+            triangles,
+            cached: true,
+        });
+    }
+    let (points, source_triangles) = read_points(&bytes, path, scale)?;
+    let (hull, triangles) = try_convex_hull(&points).map_err(|e| format!("has no convex hull ({e:?}): is it flat?"))?;
+    let points: Vec<[f32; 3]> = hull.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let made = MeshHull {
+        path: path.to_path_buf(),
+        source_triangles,
+        points,
+        triangles,
+        cached: false,
+    };
+    if made.shape().is_none() || is_flat(&made.points, &made.triangles) {
+        return Err("has no convex hull with a volume: is it flat?".to_string());
+    }
+    if let Some(dir) = cache {
+        cache::write(dir, &key, &made.points, &made.triangles, source_triangles);
+    }
+    Ok(made)
+}
+
+/// Whether a hull encloses (almost) no volume: less than 1e-9 of its bounding box's diagonal
+/// cubed (a flat or needle-thin mesh, which rapier cannot give a contact normal).
+fn is_flat(points: &[[f32; 3]], triangles: &[[u32; 3]]) -> bool {
+    let p = |i: u32| nalgebra::Vector3::from(points[i as usize].map(f64::from));
+    let volume: f64 = triangles
+        .iter()
+        .map(|t| p(t[0]).dot(&p(t[1]).cross(&p(t[2]))))
+        .sum::<f64>()
+        / 6.0;
+    let (lo, hi) = points.iter().fold(([f64::MAX; 3], [f64::MIN; 3]), |(lo, hi), q| {
+        (
+            [0, 1, 2].map(|k| lo[k].min(f64::from(q[k]))),
+            [0, 1, 2].map(|k| hi[k].max(f64::from(q[k]))),
+        )
+    });
+    let diagonal = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    volume.abs().partial_cmp(&(1e-9 * diagonal.powi(3))) != Some(std::cmp::Ordering::Greater)
+}
+
+/// The bytes of a regular file of at most [`MAX_MESH_BYTES`] (a device such as /dev/zero or a
+/// FIFO is refused, and a file growing while read is cut at the limit and refused).
+fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let cannot = |e: std::io::Error| format!("cannot read it: {e}");
+    let meta = std::fs::metadata(path).map_err(cannot)?;
+    if !meta.is_file() {
+        return Err("is not a regular file".to_string());
+    }
+    let too_big = |size: u64| format!("{size} bytes, more than the {MAX_MESH_BYTES} a mesh file may have");
+    if meta.len() > MAX_MESH_BYTES {
+        return Err(too_big(meta.len()));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_MESH_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(cannot)?;
+    if bytes.len() as u64 > MAX_MESH_BYTES {
+        return Err(too_big(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+/// Every vertex of every mesh in the file, scaled, and the number of triangles.
+fn read_points(bytes: &[u8], path: &Path, scale: [f64; 3]) -> Result<(Vec<Vector>, usize), String> {
+    // OBJ material libraries are not needed for collisions: refuse to read them.
+    let no_materials = |_: &Path| Err(std::io::Error::other("materials are not read"));
+    let scene = mesh_loader::Loader::default()
+        .load_from_slice_with_reader(bytes, path, no_materials)
+        .map_err(|e| format!("is not a mesh the STL, OBJ and COLLADA readers accept: {e}"))?;
+    let triangles: usize = scene.meshes.iter().map(|m| m.faces.len()).sum();
+    if triangles == 0 {
+        return Err("has no triangles".to_string());
+    }
+    if triangles > MAX_MESH_TRIANGLES {
+        return Err(format!(
+            "has {triangles} triangles, more than the {MAX_MESH_TRIANGLES} a collision mesh may have \
+             (simplify it first, e.g. with a decimation in MeshLab or Blender)"
+        ));
+    }
+    let s = scale.map(|v| v as f32);
+    let mut points = Vec::new();
+    for mesh in &scene.meshes {
+        for v in &mesh.vertices {
+            if !v.iter().all(|c| c.is_finite()) {
+                return Err(format!("has a non-finite vertex {v:?} in mesh {:?}", mesh.name));
+            }
+            points.push(Vector::new(v[0] * s[0], v[1] * s[1], v[2] * s[2]));
+        }
+    }
+    Ok((points, triangles))
+}
