@@ -11,7 +11,7 @@ import uuid
 import warnings
 import zipfile
 import zlib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, ClassVar, Self
@@ -433,6 +433,15 @@ class NllFit:
     jitter: float
 
 
+def lbfgs(objective: Callable[[NDArray[np.float64]], tuple[float, NDArray[np.float64]]], x0: NDArray[np.float64],
+          bounds: Sequence[tuple[float | None, float | None]], *, max_iter: int, tol: float) -> Any:
+    """scipy's L-BFGS-B on `objective` (value and gradient), stopping when the relative decrease
+    of the objective or the largest projected gradient falls below `tol`, or after `max_iter`
+    iterations: the one optimiser call of every likelihood fit here."""
+    return minimize(objective, x0, jac=True, method="L-BFGS-B", bounds=bounds,
+                    options={"maxiter": max_iter, "ftol": tol, "gtol": tol})
+
+
 def minimise_nll(
     latent: NDArray[np.float64],
     data: NDArray[np.float64],
@@ -470,14 +479,7 @@ def minimise_nll(
         [latent.ravel() if fit_latent else [], log_theta[:2], [max(log_theta[2], floor)]]
     )
     bounds = [(None, None)] * (x0.size - 1) + [(floor, None)]
-    res = minimize(
-        objective,
-        x0,
-        jac=True,
-        method="L-BFGS-B",
-        bounds=bounds,
-        options={"maxiter": max_iter, "ftol": tol, "gtol": tol},
-    )
+    res = lbfgs(objective, x0, bounds, max_iter=max_iter, tol=tol)
     z, lt = split(res.x)
     jitter = gplvm_nll_grad(z, data, lt)[3]
     return NllFit(

@@ -28,6 +28,7 @@ __all__ = [
     "bimanual_schema",
     "end_reasons",
     "fall_check",
+    "gplvm_back_constrained_nll_grad",
     "gplvm_nll_grad",
     "latent_refusal",
     "learner_values",
@@ -64,6 +65,10 @@ class GpMap:
         cls, inputs: NDArray[np.float64], outputs: NDArray[np.float64], theta: NDArray[np.float64]
     ) -> GpMap:
         """Fits the map to `inputs` (N, q) and `outputs` (N, p) with `theta` = (θ1, θ2, θ3)."""
+    @staticmethod
+    def back_constraint(inputs: NDArray[np.float64], weights: NDArray[np.float64], log_beta: float) -> GpMap:
+        """The back-constrained GPLVM's encoder: mean `weights · k_b(inputs, x)` with `weights`
+        (N, p) and the back-constraint kernel of squared length-scale `exp(log_beta)`."""
     def predict(
         self, queries: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -154,6 +159,12 @@ def gplvm_nll_grad(
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64], float]:
     """GPLVM objective at `latent` (N, d) for centred `data` (N, D):
     returns (nll, dnll/dlatent (N, d), dnll/dlog_theta (3,), jitter)."""
+def gplvm_back_constrained_nll_grad(
+    weights: NDArray[np.float64], data: NDArray[np.float64], log_theta: NDArray[np.float64], log_beta: float
+) -> tuple[float, NDArray[np.float64], NDArray[np.float64], float, NDArray[np.float64], float]:
+    """Back-constrained GPLVM objective at `weights` (N, d) for centred `data` (N, D), GPLVM kernel
+    `exp(log_theta)` and back-constraint squared length-scale `exp(log_beta)`: returns (nll,
+    dnll/dweights (N, d), dnll/dlog_theta (3,), dnll/dlog_beta, latent points (N, d), jitter)."""
 
 def arms_fk(postures: NDArray[np.float64]) -> NDArray[np.float64]:
     """Hands `(N, 4)` `[x_L, y_L, x_R, y_R]` of postures `(N, 4)` `[q1_L, q2_L, q1_R, q2_R]`

@@ -10,12 +10,13 @@ from numpy.typing import NDArray
 
 from latentrl._base import Estimator, SavedSpec, column_names, initial_log_theta, minimise_nll
 from latentrl import _native
+from latentrl.back_constraint import minimise_back_constrained
 from latentrl._native import GpMap
 from latentrl._validation import as_matrix, int_at_least, positive
 from latentrl.inverse import Projection, fit_gp_encoder
 from latentrl.pca import PCA, check_n_components
 
-ENCODERS = ("gp", "projection")
+ENCODERS = ("gp", "projection", "back_constrained")
 
 #: Standard deviation of the perturbation of the (unit-scaled) PCA start for each restart.
 RESTART_SCALE = 0.5
@@ -27,7 +28,8 @@ class GPLVM(Estimator):
     `fit` centres the postures, starts Z from PCA (scaled so the first latent axis has unit
     variance) and minimises the negative log-likelihood (Eq. 1, 3) jointly over Z and log θ
     with L-BFGS-B and the analytic gradient of the Rust core. Then it fits the
-    out-of-sample GP encoder.
+    out-of-sample GP encoder. With ``encoder="back_constrained"`` it fits Z as a kernel
+    regression on the postures instead (docs/encoders.md).
 
     Parameters
     ----------
@@ -46,8 +48,15 @@ class GPLVM(Estimator):
         the fit with the lowest objective is kept.
     random_state : int or None, default=None
         Seed of the restarts' perturbations.
-    encoder : {"gp", "projection"}, default="gp"
-        Default inverse map of `transform`.
+    encoder : {"gp", "projection", "back_constrained"}, default="gp"
+        Inverse map of `transform`: the out-of-sample GP fitted onto `Z_` after the fit (the
+        paper's), the iterative projection, or the back-constraint (Lawrence & Quiñonero-
+        Candela 2006): the latent points are fitted as a smooth function of the postures,
+        `Z_ = K_b W` (an RBF kernel regression, its weights and length scale optimised with θ
+        through the same NLL), so `transform(X_train)` is `Z_` and a new posture encodes with
+        one kernel evaluation. "gp" and "projection" fit the same model (either may be
+        chosen at `transform`); "back_constrained" fits another (with it, `transform` takes
+        "back_constrained" or "projection").
     tol : float, default=1e-6
         L-BFGS-B stops when the relative decrease of the objective (ftol) or the largest
         projected gradient component (gtol) falls below `tol` (scipy's `tol`).
@@ -76,11 +85,15 @@ class GPLVM(Estimator):
     X_train_ : ndarray (N, D)
         The training postures.
     encoder_theta_ : ndarray (3,)
-        θ of the out-of-sample GP encoder.
+        θ of the encoder: the out-of-sample GP's, or the back-constraint's (1, β, 1e-8).
+    encoder_weights_ : ndarray (N, d)
+        The back-constraint's weights W (zeros for the other encoders).
+    back_constrained_ : bool
+        Whether the fit was back-constrained.
     decoder_ : GpMap
         Z → posture (Eq. 4).
     encoder_ : GpMap
-        Posture → Z, the out-of-sample GP encoder.
+        Posture → Z: the out-of-sample GP encoder, or the back-constraint.
     projection_ : Projection
         Posture → Z by iterative projection.
     n_features_in_ : int
@@ -98,7 +111,8 @@ class GPLVM(Estimator):
     want `fit_transform(X)` to equal `transform(X)` within 1e-2, but `fit_transform`
     returns the fitted latent points `Z_` while `transform` encodes with the GP encoder, a
     smooth regression onto `Z_` that only approximates them (how closely depends on the
-    data and on where L-BFGS leaves `Z_`).
+    data and on where L-BFGS leaves `Z_`). With ``encoder="back_constrained"`` every check
+    passes: `transform(X_train)` is `Z_` (docs/encoders.md).
     `X` may be a pandas DataFrame: `transform` then wants the columns of `fit` in the same
     order, and raises a ValueError naming the unseen, missing or misplaced ones (it warns
     if only one of the two had column names). `transform`, `inverse_transform` and
@@ -113,6 +127,7 @@ class GPLVM(Estimator):
         "Z_": ("f", ("N", "d")),
         "theta_": ("f", (3,)),
         "encoder_theta_": ("f", (3,)),
+        "encoder_weights_": ("f", ("N", "d")),
         "nll_": ("f", ()),
         "n_iter_": ("i", ()),
         "converged_": ("b", ()),
@@ -165,17 +180,15 @@ class GPLVM(Estimator):
         starts = [start] + [
             start + RESTART_SCALE * rng.standard_normal(start.shape) for _ in range(n_restarts)
         ]
-        fits = [
-            minimise_nll(
-                z0,
-                centred,
-                log_theta,
-                fit_latent=True,
-                latent_prior=bool(self.latent_prior),
-                noise_floor=noise_floor,
-                max_iter=max_iter,
-                tol=tol,
-            )
+        back_constrained = self.encoder == "back_constrained"
+        if back_constrained and self.latent_prior:
+            raise ValueError("latent_prior: the back-constrained latent points are a function of X, "
+                             "not free points with a prior; use latent_prior=False")
+        fits: list[Any] = [
+            minimise_back_constrained(z0, centred, log_theta, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
+            if back_constrained else
+            minimise_nll(z0, centred, log_theta, fit_latent=True, latent_prior=bool(self.latent_prior),
+                         noise_floor=noise_floor, max_iter=max_iter, tol=tol)
             for z0 in starts
         ]
         best = min(fits, key=lambda fit: fit.nll)
@@ -191,7 +204,13 @@ class GPLVM(Estimator):
         self.converged_ = best.converged
         self.stop_reason_ = best.message
         self.jitter_ = best.jitter
-        encoder = fit_gp_encoder(X, self.Z_, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
+        if back_constrained:
+            self.encoder_weights_ = best.weights
+            encoder = GpMap.back_constraint(X, best.weights, best.log_beta)
+            self.Z_ = encoder.predict_mean(X)  # K_b W of the raw postures: what transform gives
+        else:
+            self.encoder_weights_ = np.zeros_like(self.Z_)
+            encoder = fit_gp_encoder(X, self.Z_, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
         self.encoder_theta_ = np.array(encoder.theta)
         self._build()
         return self
@@ -199,8 +218,24 @@ class GPLVM(Estimator):
     def _build(self) -> None:
         self.log_likelihood_ = -self.nll_
         self.decoder_ = GpMap(self.Z_, self.X_train_, self.theta_)
-        self.encoder_ = GpMap(self.X_train_, self.Z_, self.encoder_theta_)
+        if self.back_constrained_:
+            log_beta = float(np.log(self.encoder_theta_[1]))
+            self.encoder_ = GpMap.back_constraint(self.X_train_, self.encoder_weights_, log_beta)
+        else:
+            self.encoder_ = GpMap(self.X_train_, self.Z_, self.encoder_theta_)
         self.projection_ = Projection(self.Z_, self.X_train_, self.theta_, self.decoder_.jitter)
+
+    @property
+    def back_constrained_(self) -> bool:
+        """Whether the fitted model is back-constrained (its weights are never all zero; the
+        other encoders' are)."""
+        return bool(np.any(self.encoder_weights_))
+
+    def _restore(self, state: dict[str, Any]) -> None:
+        # Files written before the back-constraint have no weights: their encoders had none.
+        if "encoder_weights_" not in state and "Z_" in state:
+            state = {**state, "encoder_weights_": np.zeros_like(np.asarray(state["Z_"], dtype=np.float64))}
+        super()._restore(state)
 
     @staticmethod
     def _check_encoder(method: str) -> None:
@@ -213,7 +248,8 @@ class GPLVM(Estimator):
 
     def fit_transform(self, X: Any, y: Any = None) -> NDArray[np.float64]:
         """`fit(X)`, then the fitted latent points `Z_` (not re-encoded)."""
-        return self.fit(X).Z_
+        Z: NDArray[np.float64] = self.fit(X).Z_
+        return Z
 
     def transform(self, X: Any, method: str | None = None) -> NDArray[np.float64]:
         """Encodes postures `X` (M, D), an array or DataFrame, to latent points (M, d),
@@ -222,8 +258,14 @@ class GPLVM(Estimator):
         self._check_fitted()
         method = self.encoder if method is None else method
         self._check_encoder(method)
+        fitted = "back_constrained" if self.back_constrained_ else "gp"
+        if method not in (fitted, "projection"):
+            raise ValueError(f"method {method!r}: this GPLVM was fitted with the {fitted!r} encoder, "
+                             f"so transform takes {fitted!r} or 'projection'")
         X = self._check_X(X)
-        return self.encoder_.predict_mean(X) if method == "gp" else self.projection_.encode(X)
+        if method == "projection":
+            return self.projection_.encode(X)
+        return self.encoder_.predict_mean(X)
 
     @overload
     def inverse_transform(self, Z: Any, return_variance: Literal[False] = False) -> NDArray[np.float64]: ...

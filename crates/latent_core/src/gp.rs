@@ -40,6 +40,25 @@ pub(crate) fn check_gp_size(what: &'static str, n: usize) -> Result<()> {
     Ok(())
 }
 
+/// The training inputs (q×N) and per-point values (p×N, called `what`) of a map: not empty, at
+/// most [`MAX_GP_POINTS`], one value column per input, all finite.
+fn check_training(inputs: &DMatrix<f64>, values: &DMatrix<f64>, what: &'static str) -> Result<()> {
+    let n = inputs.ncols();
+    if n == 0 || inputs.nrows() == 0 {
+        return Err(CoreError::Empty { what: "inputs" });
+    }
+    check_gp_size("inputs", n)?;
+    if values.ncols() != n || values.nrows() == 0 {
+        return Err(CoreError::Shape {
+            what,
+            expected: format!("({n}, p) with p >= 1"),
+            got: format!("({}, {})", values.ncols(), values.nrows()),
+        });
+    }
+    check_finite("inputs", inputs.as_slice())?;
+    check_finite(what, values.as_slice())
+}
+
 /// Reusable buffers for [`GpMap::predict_into`], so a prediction allocates nothing.
 #[derive(Debug, Clone)]
 pub struct PredictScratch {
@@ -51,20 +70,8 @@ impl GpMap {
     /// Fits the map: `inputs` is q×N, `outputs` p×N (one point per column). Outputs are
     /// centred here and the mean is added back on prediction.
     pub fn new(inputs: DMatrix<f64>, outputs: DMatrix<f64>, kernel: SeKernel) -> Result<Self> {
+        check_training(&inputs, &outputs, "outputs")?;
         let n = inputs.ncols();
-        if n == 0 || inputs.nrows() == 0 {
-            return Err(CoreError::Empty { what: "inputs" });
-        }
-        check_gp_size("inputs", n)?;
-        if outputs.ncols() != n || outputs.nrows() == 0 {
-            return Err(CoreError::Shape {
-                what: "outputs",
-                expected: format!("({n}, p) with p >= 1"),
-                got: format!("({}, {})", outputs.ncols(), outputs.nrows()),
-            });
-        }
-        check_finite("inputs", inputs.as_slice())?;
-        check_finite("outputs", outputs.as_slice())?;
         let mean = outputs.column_mean();
         let centred_t = (&outputs - &mean * DMatrix::from_element(1, n, 1.0)).transpose();
         let factor = factorize(kernel.matrix(&inputs))?;
@@ -82,6 +89,22 @@ impl GpMap {
             alpha_t,
             lower: factor.cholesky.l(),
             mean,
+            jitter: factor.jitter,
+        })
+    }
+
+    /// A kernel regression with given weights: the mean at `x` is `weights · k(inputs, x)`
+    /// (`weights` p×N, no output mean), the variance that of a GP on `inputs` with `kernel`.
+    /// The back-constrained GPLVM's encoder ([`crate::back_constraint::encoder`]).
+    pub fn from_weights(inputs: DMatrix<f64>, weights: DMatrix<f64>, kernel: SeKernel) -> Result<Self> {
+        check_training(&inputs, &weights, "weights")?;
+        let factor = factorize(kernel.matrix(&inputs))?;
+        Ok(Self {
+            kernel,
+            mean: DVector::zeros(weights.nrows()),
+            alpha_t: weights,
+            inputs,
+            lower: factor.cholesky.l(),
             jitter: factor.jitter,
         })
     }

@@ -3,6 +3,7 @@
 //! every step in latent space. Pure Rust: no Python needed to use or test it.
 #![warn(missing_docs)]
 
+pub mod back_constraint;
 pub mod config;
 pub mod episode;
 pub mod error;

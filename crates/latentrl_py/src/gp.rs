@@ -1,5 +1,6 @@
 //! Binding of `latent_core::gp` and `latent_core::gplvm`.
 
+use latent_core::back_constraint::{encoder, nll_grad_back_constrained};
 use latent_core::{GpMap, SeKernel, nll_grad};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -12,6 +13,16 @@ type MeansVariances<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>
 
 /// (nll, ∂nll/∂latent (N, d), ∂nll/∂log θ (3,), jitter).
 type NllGradient<'py> = (f64, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>, f64);
+
+/// (nll, ∂nll/∂weights (N, d), ∂nll/∂log θ (3,), ∂nll/∂log β, latent (N, d), jitter).
+type BackConstrainedGradient<'py> = (
+    f64,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    f64,
+    Bound<'py, PyArray2<f64>>,
+    f64,
+);
 
 /// A fitted GP map (paper Eq. 4): predictive mean and variance from inputs to outputs.
 #[pyclass(name = "GpMap", module = "latentrl._native", frozen)]
@@ -35,6 +46,23 @@ impl PyGpMap {
             let outputs = points("outputs", &outputs)?;
             let kernel = SeKernel::new(fixed::<3>("theta", &theta)?).map_err(to_py)?;
             let inner = py.detach(|| GpMap::new(inputs, outputs, kernel)).map_err(to_py)?;
+            Ok(Self { inner })
+        })
+    }
+
+    /// The back-constrained GPLVM's encoder: mean `weights · k_b(inputs, x)` with `weights`
+    /// (N, p) and the back-constraint kernel of squared length-scale `exp(log_beta)`.
+    #[staticmethod]
+    fn back_constraint(
+        py: Python<'_>,
+        inputs: PyReadonlyArray2<'_, f64>,
+        weights: PyReadonlyArray2<'_, f64>,
+        log_beta: f64,
+    ) -> PyResult<Self> {
+        guard(|| {
+            let inputs = points("inputs", &inputs)?;
+            let weights = points("weights", &weights)?;
+            let inner = py.detach(|| encoder(inputs, weights, log_beta)).map_err(to_py)?;
             Ok(Self { inner })
         })
     }
@@ -127,6 +155,35 @@ pub fn gplvm_nll_grad<'py>(
             r.nll,
             to_points(py, r.grad_latent)?,
             PyArray1::from_vec(py, r.grad_log_theta.to_vec()),
+            r.jitter,
+        ))
+    })
+}
+
+/// Back-constrained GPLVM objective at `weights` (N, d) for centred `data` (N, D), GPLVM kernel
+/// `exp(log_theta)` and back-constraint squared length-scale `exp(log_beta)`: returns (nll,
+/// dnll/dweights (N, d), dnll/dlog_theta (3,), dnll/dlog_beta, latent points (N, d), jitter).
+#[pyfunction]
+pub fn gplvm_back_constrained_nll_grad<'py>(
+    py: Python<'py>,
+    weights: PyReadonlyArray2<'py, f64>,
+    data: PyReadonlyArray2<'py, f64>,
+    log_theta: PyReadonlyArray1<'py, f64>,
+    log_beta: f64,
+) -> PyResult<BackConstrainedGradient<'py>> {
+    guard(|| {
+        let weights = points("weights", &weights)?;
+        let data = points("data", &data)?;
+        let log_theta = fixed::<3>("log_theta", &log_theta)?;
+        let r = py
+            .detach(|| nll_grad_back_constrained(&weights, &data, log_theta, log_beta))
+            .map_err(to_py)?;
+        Ok((
+            r.nll,
+            to_points(py, r.grad_weights)?,
+            PyArray1::from_vec(py, r.grad_log_theta.to_vec()),
+            r.grad_log_beta,
+            to_points(py, r.latent)?,
             r.jitter,
         ))
     })

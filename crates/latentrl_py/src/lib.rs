@@ -26,6 +26,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<task::PyLatentPolicy>()?;
     m.add_class::<bimanual::PyBimanualPlant>()?;
     m.add_function(wrap_pyfunction!(gp::gplvm_nll_grad, m)?)?;
+    m.add_function(wrap_pyfunction!(gp::gplvm_back_constrained_nll_grad, m)?)?;
     m.add_function(wrap_pyfunction!(kinematics::arms_fk, m)?)?;
     m.add_function(wrap_pyfunction!(kinematics::arms_elbows, m)?)?;
     m.add_function(wrap_pyfunction!(kinematics::arms_ik, m)?)?;

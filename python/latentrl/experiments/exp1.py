@@ -62,7 +62,8 @@ def setup(preset: Exp1Preset) -> Setup:
     """Demonstrations, the GPLVM and its latent box, and both learners' trial runners."""
     plant, learner = configs(preset)
     demos = bimanual_pairs(preset.n_demos, np.random.default_rng(preset.seed))
-    model = GPLVM(n_components=2, max_iter=preset.gplvm_max_iter, random_state=preset.seed).fit(demos)
+    model = GPLVM(n_components=2, max_iter=preset.gplvm_max_iter, random_state=preset.seed,
+                  encoder=preset.encoder).fit(demos)
     low, high = latent_box(model.Z_, preset.latent_margin)
     run = partial(
         _native.run_bimanual_trials,

@@ -85,13 +85,13 @@ class Fitted:
 def fit(preset: Exp2Preset) -> Fitted:
     """Demonstrations (seeded by `preset.seed`), GPLVM and latent box; cached on the fields
     they depend on, so `setup` and `figures` (and presets that differ elsewhere) share a fit."""
-    return _fit(preset.n_demos, preset.seed, preset.gplvm_max_iter, preset.latent_margin)
+    return _fit(preset.n_demos, preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder)
 
 
 @lru_cache(maxsize=4)
-def _fit(n_demos: int, seed: int, max_iter: int, margin: float) -> Fitted:
+def _fit(n_demos: int, seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
     demos = arm_postures(n_demos, np.random.default_rng(seed))
-    model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed).fit(demos)
+    model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder).fit(demos)
     low, high = latent_box(model.Z_, margin)
     return Fitted(demos, model, low, high)
 

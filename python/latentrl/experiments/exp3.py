@@ -92,14 +92,14 @@ class Fitted:
 
 def fit(preset: Exp3Preset) -> Fitted:
     """Demos, GPLVM and latent box; cached on the fields they depend on."""
-    return _fit(preset.seed, preset.gplvm_max_iter, preset.latent_margin)
+    return _fit(preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder)
 
 
 @lru_cache(maxsize=4)
-def _fit(seed: int, max_iter: int, margin: float) -> Fitted:
+def _fit(seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
     joints = Task.shipped("humanoid_lift").joint_names
     demos = load_demos(demos_path(), expected_joints=joints).postures
-    model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed).fit(demos)
+    model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder).fit(demos)
     low, high = latent_box(model.Z_, margin)
     return Fitted(demos, model, low, high)
 

@@ -24,6 +24,10 @@ import numpy as np
 from latentrl import _native
 from latentrl._validation import int_at_least
 
+#: The encoders a latent RL run can use inside the native loop (the iterative projection is
+#: Python-only).
+RL_ENCODERS = ("gp", "back_constrained")
+
 
 @cache
 def field_docs(preset_cls: type) -> dict[str, str]:
@@ -98,6 +102,8 @@ class LatentRun:
     """Frozen test episodes per trial after training (no TD updates, the task's test starts); 0 = none."""
     gplvm_max_iter: int = 1000
     """L-BFGS iteration cap of the GPLVM fit."""
+    encoder: str = "gp"
+    """Posture → latent map of the RL loop: "gp" (the paper's out-of-sample GP onto the fitted points) or "back_constrained" (the GPLVM fitted with Z = g(X), encoding its demos exactly; docs/encoders.md)."""
     latent_margin: float = 0.1
     """Latent box = bounding box of the fitted latent points, widened by this share per side (ours: 10 %)."""
     task: Mapping[str, Any] = field(default_factory=dict)
@@ -112,6 +118,8 @@ class LatentRun:
         check_ints(self, ("trials", "episodes", "gplvm_max_iter"))
         check_ints(self, ("seed", "test_episodes"), minimum=0)
         check_floats(self, ("latent_margin",), positive=False)
+        if self.encoder not in RL_ENCODERS:
+            raise ValueError(f"encoder: expected one of {', '.join(RL_ENCODERS)}, got {self.encoder!r}")
         records = self.trials * (self.episodes + self.test_episodes)
         if records > _native.MAX_EPISODES:
             raise ValueError(

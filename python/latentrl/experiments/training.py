@@ -40,11 +40,11 @@ class TrainRun(TrainPreset):
 
 @lru_cache(maxsize=2)
 def _load(task_file: str, overrides: tuple[tuple[str, Any], ...], demos: str, model: str,
-          seed: int, max_iter: int) -> tuple[Task, np.ndarray, GPLVM]:
+          seed: int, max_iter: int, encoder: str) -> tuple[Task, np.ndarray, GPLVM]:
     task = Task.load(task_file).replace(dict(overrides))
     postures = load_demos(demos, min_postures=3)
     task.check_joints(postures.joint_names, demos)
-    gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed)
+    gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder)
     if model:
         if gplvm.n_features_in_ != len(task.joint_names):
             raise ValueError(f"{model}: fitted to {gplvm.n_features_in_} joints, the task's robot has {len(task.joint_names)}")
@@ -57,7 +57,7 @@ def fitted(run: TrainRun) -> tuple[Task, np.ndarray, GPLVM]:
     """The task (with the run's overrides), the demo postures and the GPLVM (fitted or loaded);
     cached, so validation and setup share the fit."""
     overrides = tuple(sorted(run.task.items()))
-    return _load(run.task_file, overrides, run.demos, run.model, run.seed, run.gplvm_max_iter)
+    return _load(run.task_file, overrides, run.demos, run.model, run.seed, run.gplvm_max_iter, run.encoder)
 
 
 def setup(run: TrainRun) -> Setup:
