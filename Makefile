@@ -6,7 +6,7 @@ export CARGO_TARGET_DIR ?= $(CURDIR)/target
 
 INSTALL_VENV := target/install-check-venv
 
-.PHONY: help demo test test-all bench lint build install-check fuzz clean
+.PHONY: help demo test test-all bench lint build wheel install-check fuzz clean
 .DEFAULT_GOAL := help
 
 help: ## list the targets
@@ -61,19 +61,31 @@ lint: build ## rustfmt, clippy (warnings are errors), the native stubs against t
 	$(PY) -m mypy.stubtest latentrl._native
 	$(PY) -m mypy --strict python/latentrl
 
-install-check: ## `pip install .` into a fresh venv as a user would, then use the installed package from outside the tree, without and with the [plot] extra
+WHEELS := target/wheels
+# What a user without Rust has: the venv's own bin and the system's, no ~/.cargo/bin.
+NO_RUST_PATH = $(CURDIR)/$(INSTALL_VENV)/bin:/usr/bin:/bin
+
+wheel: build ## the abi3 wheel (one for every CPython >= 3.11, manylinux) and the sdist, into target/wheels/
+	rm -rf $(WHEELS)
+	$(VENV)/bin/maturin build --release --quiet -o $(WHEELS)
+	$(VENV)/bin/maturin sdist -o $(WHEELS) > /dev/null
+	tar -tzf $(WHEELS)/latentrl-*.tar.gz | grep -q 'crates/latent_core/src/lib.rs'
+
+install-check: wheel ## the wheel into a fresh venv on a PATH without cargo or rustc, then used from outside the tree, without and with the [plot] extra
 	rm -rf $(INSTALL_VENV)
 	$(PYTHON) -m venv $(INSTALL_VENV)
-	$(INSTALL_VENV)/bin/python -m pip install --quiet --upgrade pip
-	$(INSTALL_VENV)/bin/python -m pip install --quiet .
+	PATH=$(NO_RUST_PATH) sh -c '! command -v cargo && ! command -v rustc'
+	PATH=$(NO_RUST_PATH) $(INSTALL_VENV)/bin/python -m pip install --quiet --upgrade pip
+	PATH=$(NO_RUST_PATH) $(INSTALL_VENV)/bin/python -m pip install --quiet --only-binary latentrl $(WHEELS)/latentrl-*abi3*.whl
 	cd $(INSTALL_VENV) && bin/python -c "import sys, latentrl; sys.exit(latentrl.__file__.startswith('$(CURDIR)/python'))"
-	cd $(INSTALL_VENV) && bin/python -m latentrl info > /dev/null
+	cd $(INSTALL_VENV) && bin/python -c "import sys, latentrl._native as n; sys.exit(not n.__file__.endswith('.abi3.so'))"
+	cd $(INSTALL_VENV) && PATH=$(NO_RUST_PATH) bin/python -m latentrl info > /dev/null
 	cd $(INSTALL_VENV) && bin/python -c "import importlib.util, sys; sys.exit(importlib.util.find_spec('matplotlib') is not None)"
-	cd $(INSTALL_VENV) && bin/python $(CURDIR)/tests/core_without_matplotlib.py
-	$(INSTALL_VENV)/bin/python -m pip install --quiet "latentrl[plot]"
-	cd $(INSTALL_VENV) && bin/latentrl run exp2 --quick --no-progress --trials 1 --episodes 2 --episode.max-steps 10 \
+	cd $(INSTALL_VENV) && PATH=$(NO_RUST_PATH) bin/python $(CURDIR)/tests/core_without_matplotlib.py
+	PATH=$(NO_RUST_PATH) $(INSTALL_VENV)/bin/python -m pip install --quiet "latentrl[plot]"
+	cd $(INSTALL_VENV) && PATH=$(NO_RUST_PATH) bin/latentrl run exp2 --quick --no-progress --trials 1 --episodes 2 --episode.max-steps 10 \
 		--test-episodes 1 --fig5-samples 50 --gplvm-max-iter 20 --out run
-	cd $(INSTALL_VENV) && test -s run/results.json && test -s run/fig6a.png && echo "install-check: pip install . works"
+	cd $(INSTALL_VENV) && test -s run/results.json && test -s run/fig6a.png && echo "install-check: the abi3 wheel installs and runs without Rust"
 
 FUZZ_TARGET ?= urdf_parse
 FUZZ_SECONDS ?= 180
