@@ -6,7 +6,7 @@ export CARGO_TARGET_DIR ?= $(CURDIR)/target
 
 INSTALL_VENV := target/install-check-venv
 
-.PHONY: help demo test test-all bench lint build wheel install-check fuzz clean
+.PHONY: help demo test test-all bench lint build wheel install-check fuzz fuzz-py clean
 .DEFAULT_GOAL := help
 
 help: ## list the targets
@@ -89,13 +89,21 @@ install-check: wheel ## the wheel into a fresh venv on a PATH without cargo or r
 
 FUZZ_TARGET ?= urdf_parse
 FUZZ_SECONDS ?= 180
+# Seeds and dictionary per target: the shipped URDFs for the URDF targets, the test arm's meshes for mesh_parse.
+FUZZ_SEEDS = $(if $(filter mesh_parse,$(FUZZ_TARGET)),tests/robots/arm7_description/meshes/collision,python/latentrl/data)
+FUZZ_DICT = $(if $(filter mesh_parse,$(FUZZ_TARGET)),,-dict=fuzz/urdf.dict)
 
-fuzz: ## cargo fuzz the URDF parser + physics for FUZZ_SECONDS (180) s; FUZZ_TARGET=urdf_parse|urdf_numbers; installs cargo-fuzz if missing
+fuzz: ## cargo fuzz the URDF parser + physics, or the mesh reader, for FUZZ_SECONDS (180) s; FUZZ_TARGET=urdf_parse|urdf_numbers|mesh_parse; installs cargo-fuzz if missing
 	@command -v cargo-fuzz > /dev/null || cargo install --locked cargo-fuzz
 	mkdir -p fuzz/corpus/$(FUZZ_TARGET)
 	RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(CURDIR)/fuzz/target nice -n 10 cargo fuzz run --sanitizer none $(FUZZ_TARGET) \
-		fuzz/corpus/$(FUZZ_TARGET) python/latentrl/data -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 -dict=fuzz/urdf.dict \
+		fuzz/corpus/$(FUZZ_TARGET) $(FUZZ_SEEDS) -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 $(FUZZ_DICT) \
 		-print_final_stats=1
+
+fuzz-py: build ## atheris on the demo-file and saved-model readers for FUZZ_SECONDS (180) s; installs atheris if missing
+	@$(PY) -c "import atheris" 2> /dev/null || $(PY) -m pip install --quiet atheris
+	mkdir -p fuzz/corpus/demos
+	nice -n 10 $(PY) fuzz/fuzz_demos_models.py fuzz/corpus/demos -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1
 
 clean: ## remove the venv and build outputs
 	rm -rf $(VENV) target

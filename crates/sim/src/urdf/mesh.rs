@@ -113,7 +113,17 @@ pub fn load_hull(path: &Path, scale: [f64; 3], cache: Option<&Path>) -> Result<M
             cached: true,
         });
     }
-    let (points, source_triangles) = read_points(&bytes, path, scale)?;
+    let made = hull_of_bytes(&bytes, path, scale)?;
+    if let Some(dir) = cache {
+        cache::write(dir, &key, &made.points, &made.triangles, made.source_triangles);
+    }
+    Ok(made)
+}
+
+/// The convex hull of the mesh file held in `bytes` (`path` names it and gives its format by
+/// extension), scaled: [`load_hull`] without the file and the cache (the fuzz target's entry).
+pub fn hull_of_bytes(bytes: &[u8], path: &Path, scale: [f64; 3]) -> Result<MeshHull, String> {
+    let (points, source_triangles) = read_points(bytes, path, scale)?;
     let (hull, triangles) = try_convex_hull(&points).map_err(|e| format!("has no convex hull ({e:?}): is it flat?"))?;
     let points: Vec<[f32; 3]> = hull.iter().map(|p| [p.x, p.y, p.z]).collect();
     let made = MeshHull {
@@ -125,9 +135,6 @@ pub fn load_hull(path: &Path, scale: [f64; 3], cache: Option<&Path>) -> Result<M
     };
     if made.shape().is_none() || is_flat(&made.points, &made.triangles) {
         return Err("has no convex hull with a volume: is it flat?".to_string());
-    }
-    if let Some(dir) = cache {
-        cache::write(dir, &key, &made.points, &made.triangles, source_triangles);
     }
     Ok(made)
 }
