@@ -6,7 +6,7 @@ export CARGO_TARGET_DIR ?= $(CURDIR)/target
 
 INSTALL_VENV := target/install-check-venv
 
-.PHONY: help demo test test-all bench lint build wheel install-check fuzz fuzz-py clean
+.PHONY: help demo test test-all bench figures lint build wheel install-check fuzz fuzz-py clean
 .DEFAULT_GOAL := help
 
 help: ## list the targets
@@ -15,7 +15,7 @@ help: ## list the targets
 $(VENV)/.deps: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib tqdm gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm scikit-learn pandas "ray>=2.9"
+	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib "imageio>=2.31" "imageio-ffmpeg>=0.5" tqdm gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm scikit-learn pandas "ray>=2.9"
 	touch $@
 
 # The old extension is unlinked first: maturin would overwrite it in place, under the feet of a
@@ -54,6 +54,12 @@ bench: build ## criterion benches, the NumPy loop, GPy, MuJoCo and Pinocchio com
 	benches/.venv-bench/bin/python benches/bench_gp.py
 	benches/.venv-bench/bin/python benches/bench_sim.py
 	benches/.venv-bench/bin/python benches/bench_urdf.py
+
+figures: build ## the README's two GIFs: quick Exp 2 and Exp 3 runs into results/, then latentrl replay of a frozen test episode of each
+	$(PY) -m latentrl run exp2 --quick --no-progress --out results/exp2-quick
+	$(PY) -m latentrl run exp3 --quick --no-progress --out results/exp3-quick
+	$(PY) -m latentrl replay results/exp2-quick --test 0 --out docs/figures/exp2-quick-pass.gif --width 640 --fps 10 --max-frames 100
+	$(PY) -m latentrl replay results/exp3-quick --test 2 --out docs/figures/exp3-quick-lift.gif --width 640 --fps 10 --max-frames 101
 
 lint: build ## rustfmt, clippy (warnings are errors), the native stubs against the module, mypy --strict
 	cargo fmt --all --check

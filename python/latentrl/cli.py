@@ -178,6 +178,16 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--resume", action="store_true", help="continue the sweep in --out; finished trials are kept")
     sweep.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     sub.add_parser("info", help="print versions, git revision and thread count as JSON")
+    replay = sub.add_parser("replay", help="render a recorded episode of an Exp 2 or Exp 3 run to a GIF or MP4 (the [video] extra)")
+    replay.add_argument("results", type=Path, help="a results directory of latentrl run exp2|exp3")
+    replay.add_argument("--out", type=Path, required=True, help="the video: FILE.gif or FILE.mp4")
+    which = replay.add_mutually_exclusive_group(required=True)
+    which.add_argument("--episode", type=int, help="a recorded training episode (the first, 10 %%, 50 %% and the last three)")
+    which.add_argument("--test", type=int, help="a recorded frozen test episode (the first ten)")
+    replay.add_argument("--trial", type=int, default=0, help="the trial (default 0)")
+    replay.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")
+    replay.add_argument("--width", type=int, default=960, help="frame width in pixels, height half of it (default 960)")
+    replay.add_argument("--max-frames", type=int, default=400, help="at most this many frames, evenly spaced over the episode (default 400)")
     urdf = sub.add_parser("urdf-info", help="what a URDF holds as the physics loads it: joints, links, collision shapes, mass")
     urdf.add_argument("urdf", type=Path, help="the robot's URDF file")
     urdf.add_argument("--json", action="store_true", help="print it as JSON instead of a table")
@@ -336,6 +346,16 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _replay(args: argparse.Namespace) -> int:
+    from latentrl.replay import replay
+
+    name, preset = saved_run(args.results)
+    what = replay(args.results, name, preset, args.out, trial=args.trial, episode=args.episode, test=args.test,
+                  fps=args.fps, width=args.width, max_frames=args.max_frames)
+    print(f"{what} in {args.out}")
+    return 0
+
+
 def _urdf_info(args: argparse.Namespace) -> int:
     from latentrl.robot_info import format_info, urdf_info
 
@@ -364,11 +384,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(json.dumps(environment(), indent=2))
         return 0
     command = {"run": _run, "train": _train, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep,
-               "urdf-info": _urdf_info}
+               "urdf-info": _urdf_info, "replay": _replay}
     try:
         out = getattr(args, "out", None)
         if out is not None:
-            _check_writable(out, file=args.command == "fit")
+            _check_writable(out, file=args.command in ("fit", "replay"))
         return command[args.command](args)
     except (ValueError, OSError) as err:
         print(f"latentrl: error: {err}", file=sys.stderr)

@@ -101,7 +101,7 @@ def latent_value_panel(
     value = value.reshape(shape)
     extent = (low[0], high[0], low[1], high[1])
     image = ax.imshow(value, origin="lower", extent=extent, aspect="auto", cmap="viridis")
-    plt.colorbar(image, ax=ax, label="V")
+    ax.figure.colorbar(image, ax=ax, label="V")
     # Log scale: the variance spans orders of magnitude from the demonstrations to the corners.
     log_var = np.log(np.maximum(variance, 1e-300))
     shade = ((log_var - log_var.min()) / max(np.ptp(log_var), 1e-12)).reshape(shape)

@@ -36,31 +36,78 @@ def view_axes(task: Task) -> tuple[int, int]:
 
 def draw_task(task: Task, plant: _native.TaskPlant, size: int = 400) -> NDArray[np.uint8]:
     """An RGB image (size, size, 3) of the task's robot as the plant holds it now."""
+    fig, ax = _canvas(size)
+    draw_scene(ax, task, np.asarray(plant.link_poses()))
+    return _pixels(fig)
+
+
+def draw_scene(ax: Any, task: Task, poses: NDArray[np.float64], limits: tuple[Any, Any] | None = None) -> None:
+    """The task's robot at link poses `poses` (L, 7) on `ax`: its box, sphere, cylinder and
+    capsule collision shapes as solids, the kinematic tree as sticks, the obstacles, the floor
+    and the target, in `view_axes`; the view fits robot and target unless `limits` are given."""
     from matplotlib.patches import Rectangle
 
     a, b = view_axes(task)
     config = task.to_dict()
-    poses = np.asarray(plant.link_poses())
     positions = {name: pose[:3] for name, pose in zip(task.link_names, poses) if np.all(np.isfinite(pose))}
     target = np.asarray(config["target"]["position"], dtype=np.float64).reshape(-1, 3)
-    fig, ax = _canvas(size)
-    # The view: the robot and the target, with a margin (the obstacles may reach beyond it).
-    points = np.vstack([*positions.values(), target])[:, [a, b]]
-    low, high = points.min(axis=0), points.max(axis=0)
-    centre = (low + high) / 2
-    half = max(0.2, 0.6 * float((high - low).max()))
-    ax.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half))
+    if limits is None:
+        # The view: the robot and the target, with a margin (the obstacles may reach beyond it).
+        points = np.vstack([*positions.values(), target])[:, [a, b]]
+        low, high = points.min(axis=0), points.max(axis=0)
+        centre = (low + high) / 2
+        half = max(0.2, 0.6 * float((high - low).max()))
+        limits = ((centre[0] - half, centre[0] + half), (centre[1] - half, centre[1] + half))
+    ax.set(xlim=limits[0], ylim=limits[1])
     for box in config["obstacles"]:
         lo, hi = _corners(box)
         ax.add_patch(Rectangle((lo[a], lo[b]), hi[a] - lo[a], hi[b] - lo[b], color="0.6"))
     if config["floor"] is not None and b == 2:
         ax.axhline(config["floor"]["height"], color="0.4", lw=2)
+    pose_of = dict(zip(task.link_names, poses))
+    for shape in task._native.collision_shapes():
+        outline = shape_outline(pose_of[shape["link"]], shape, (a, b))
+        if outline is not None:
+            ax.fill(outline[:, 0], outline[:, 1], color="C0", alpha=0.35, lw=0)
     for parent, child in task.edges:
         if parent in positions and child in positions:
             p, c = positions[parent], positions[child]
             ax.plot([p[a], c[a]], [p[b], c[b]], "o-", color="C0", lw=2, ms=3)
     ax.plot(target[:, a], target[:, b], "g*", ms=10)
-    return _pixels(fig)
+
+
+def shape_outline(link_pose: NDArray[np.float64], shape: Mapping[str, Any], view: tuple[int, int]) -> NDArray[np.float64] | None:
+    """The outline (K, 2) of a primitive collision shape of a link at `link_pose`, projected on
+    the `view` axes (the convex hull of its corners, or of points on its end circles); None for
+    a mesh (drawn by its link's stick) or a shape seen edge-on."""
+    from scipy.spatial import ConvexHull, QhullError
+    from scipy.spatial.transform import Rotation
+
+    size = np.asarray(shape["size"], dtype=np.float64)
+    angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    ring = np.column_stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)])
+    if shape["kind"] == "box":
+        local = np.array([[(k >> i & 1) - 0.5 for i in range(3)] for k in range(8)]) * size
+    elif shape["kind"] == "sphere":
+        sphere = np.vstack([ring, ring[:, [0, 2, 1]], ring[:, [2, 0, 1]]])
+        local = sphere * size[0]
+    elif shape["kind"] in ("cylinder", "capsule"):
+        radius, length = size
+        ends = [ring * radius + [0, 0, z] for z in (-length / 2, length / 2)]
+        if shape["kind"] == "capsule":
+            ends += [np.vstack([ring, ring[:, [0, 2, 1]], ring[:, [2, 0, 1]]]) * radius + [0, 0, z]
+                     for z in (-length / 2, length / 2)]
+        local = np.vstack(ends)
+    else:
+        return None
+    origin = np.asarray(shape["origin"], dtype=np.float64)
+    world = Rotation.from_quat(link_pose[3:]).apply(Rotation.from_quat(origin[3:]).apply(local) + origin[:3]) + link_pose[:3]
+    flat = world[:, list(view)]
+    try:
+        hull = ConvexHull(flat)
+    except QhullError:
+        return None
+    return flat[hull.vertices]
 
 
 def _corners(box: Mapping[str, Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
