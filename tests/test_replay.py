@@ -62,3 +62,16 @@ def test_a_suffix_it_cannot_write_and_a_missing_extra_are_named(runs, tmp_path):
     err = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert err.returncode == 1 and "pip install 'latentrl[video]'" in err.stderr
     assert not (tmp_path / "x.gif").exists()
+
+
+def test_a_latentrl_train_run_on_a_custom_task_replays(tmp_path):
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    run = tmp_path / "glass"
+    assert main(["train", str(example / "glass_arm.toml"), "--demos", str(example / "demos.csv"), "--out", str(run),
+                 "--quick", "--trials", "1", "--episodes", "3", "--test-episodes", "1", "--episode.max-steps", "8",
+                 "--no-progress"]) == 0
+    out = tmp_path / "glass.gif"
+    assert main(["replay", str(run), "--test", "0", "--out", str(out)]) == 0
+    assert iio.imread(out).shape[1:] == (480, 960, 3)

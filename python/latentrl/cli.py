@@ -178,8 +178,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--resume", action="store_true", help="continue the sweep in --out; finished trials are kept")
     sweep.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     sub.add_parser("info", help="print versions, git revision and thread count as JSON")
-    replay = sub.add_parser("replay", help="render a recorded episode of an Exp 2 or Exp 3 run to a GIF or MP4 (the [video] extra)")
-    replay.add_argument("results", type=Path, help="a results directory of latentrl run exp2|exp3")
+    replay = sub.add_parser("replay", help="render a recorded episode of an Exp 2, Exp 3 or latentrl train run to a GIF or MP4 (the [video] extra)")
+    replay.add_argument("results", type=Path, help="a results directory of latentrl run exp2|exp3 or latentrl train")
     replay.add_argument("--out", type=Path, required=True, help="the video: FILE.gif or FILE.mp4")
     which = replay.add_mutually_exclusive_group(required=True)
     which.add_argument("--episode", type=int, help="a recorded training episode (the first, 10 %%, 50 %% and the last three)")
@@ -346,10 +346,24 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
+def _replayable_run(out_dir: Path) -> tuple[str, Any]:
+    """("train", its TrainRun) for a `latentrl train` directory, else `saved_run`."""
+    from latentrl.experiments.training import TrainRun
+
+    meta = out_dir / "results.json"
+    fields = dict(read_json(meta).get("preset") or {}) if meta.is_file() else {}
+    if fields.pop("name", None) == TrainRun.__name__:
+        unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(TrainRun)})
+        if unknown:
+            raise ValueError(f"{out_dir}: its preset has fields this version does not know: {unknown}")
+        return "train", TrainRun(**fields)
+    return saved_run(out_dir)
+
+
 def _replay(args: argparse.Namespace) -> int:
     from latentrl.replay import replay
 
-    name, preset = saved_run(args.results)
+    name, preset = _replayable_run(args.results)
     what = replay(args.results, name, preset, args.out, trial=args.trial, episode=args.episode, test=args.test,
                   fps=args.fps, width=args.width, max_frames=args.max_frames)
     print(f"{what} in {args.out}")

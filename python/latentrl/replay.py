@@ -7,6 +7,7 @@ path. GIF with Pillow, MP4 with the ffmpeg that imageio-ffmpeg ships: the `[vide
 from __future__ import annotations
 
 import os
+from importlib import import_module
 from pathlib import Path
 from typing import Any
 
@@ -16,8 +17,9 @@ from numpy.typing import NDArray
 #: What `replay` writes, by suffix.
 FORMATS = (".gif", ".mp4")
 
-#: The experiments whose runs store robot paths (Exp 1's toy stores hand positions only).
-REPLAYABLE = ("exp2", "exp3")
+#: The runs that store robot paths: Exp 2, Exp 3 and `latentrl train` on any task (Exp 1's toy
+#: stores hand positions only).
+REPLAYABLE = ("exp2", "exp3", "train")
 
 
 def episode_path(arrays: dict[str, NDArray[Any]], trial: int, episode: int | None, test: int | None,
@@ -121,17 +123,30 @@ def write_video(frames: NDArray[np.uint8], out: Path, fps: int) -> None:
         temp.unlink(missing_ok=True)
 
 
+def run_setup(experiment: str, preset: Any) -> tuple[Any, Any, tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """The task, the GPLVM and the latent box of a run, as it was trained (the fit is
+    deterministic in the saved preset)."""
+    if experiment == "train":
+        from latentrl.experiments.presets import latent_box
+        from latentrl.experiments.training import fitted
+
+        task, _, model = fitted(preset)
+        return task, model, latent_box(model.Z_, preset.latent_margin)
+    module = import_module(f"latentrl.experiments.{experiment}")
+    fit = module.fit(preset)
+    return module.task_of(preset), fit.model, (fit.low, fit.high)
+
+
 def replay(run_dir: Path, experiment: str, preset: Any, out: Path, *, trial: int = 0,
            episode: int | None = None, test: int | None = None, fps: int = 20, width: int = 960,
            max_frames: int = 400) -> str:
-    """Renders one recorded episode of the run in `run_dir` (experiment `experiment`, its saved
-    `preset`) to `out`; returns what was rendered. Every argument is checked before drawing."""
-    from importlib import import_module
-
+    """Renders one recorded episode of the run in `run_dir` (`experiment` "exp2", "exp3" or
+    "train", its saved `preset`) to `out`; returns what was rendered. Every argument is checked
+    before drawing."""
     from latentrl.experiments.runner import load_arrays
 
     if experiment not in REPLAYABLE:
-        raise ValueError(f"{run_dir}: a run of {experiment}; replay draws robot runs ({', '.join(REPLAYABLE)})")
+        raise ValueError(f"{run_dir}: a run of {experiment}; replay draws robot runs (exp2, exp3, latentrl train)")
     if (episode is None) == (test is None):
         raise ValueError("give one of --episode E (a recorded training episode) or --test T (a frozen test episode)")
     for flag, value, least in (("--fps", fps, 1), ("--width", width, 200), ("--max-frames", max_frames, 2)):
@@ -143,10 +158,8 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path, *, trial: int
     weights = arrays.get("latent_weights")
     if weights is None:
         raise ValueError(f"{run_dir}: the run kept no learnt weights to draw V from")
-    module = import_module(f"latentrl.experiments.{experiment}")
-    fitted = module.fit(preset)
-    task = module.task_of(preset)
-    frames = render_frames(task, fitted.model, (fitted.low, fitted.high), np.asarray(weights)[trial], rows,
-                           f"{experiment}: {what}", size=(width, width // 2), max_frames=max_frames)
+    task, model, box = run_setup(experiment, preset)
+    frames = render_frames(task, model, box, np.asarray(weights)[trial], rows, f"{task.name}: {what}",
+                           size=(width, width // 2), max_frames=max_frames)
     write_video(frames, out, fps)
     return f"{what}: {len(frames)} frames"
