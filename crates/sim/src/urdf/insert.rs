@@ -153,20 +153,18 @@ impl UrdfModel {
     fn add_hull_colliders(&self, robot: &mut UrdfRobot, options: &UrdfLoaderOptions) -> Result<()> {
         for ((l, c), hull) in &self.hulls {
             let link = &self.robot.links[*l];
-            let failed = |reason: &str| SimError::Mesh {
-                link: link.name.clone(),
-                path: hull.path.display().to_string(),
-                reason: reason.to_string(),
-                origin: self.origin.clone(),
-            };
-            let shape = hull.shape().ok_or_else(|| failed("its hull has no volume"))?;
             let body = robot
                 .links
                 .iter_mut()
                 .find(|b| b.urdf_link_index == *l)
-                .ok_or_else(|| failed("its link was not made a body"))?;
+                .ok_or_else(|| SimError::Mesh {
+                    link: link.name.clone(),
+                    path: hull.path.display().to_string(),
+                    reason: "its link was not made a body".to_string(),
+                    origin: self.origin.clone(),
+                })?;
             let mut builder = options.collider_blueprint.clone();
-            builder.shape = shape;
+            builder.shape = hull.shape.clone();
             let collider = builder
                 .position(to_pose(&origin_pose(&link.collision[*c].origin)))
                 .build();

@@ -39,13 +39,32 @@ pub struct MeshHull {
     pub triangles: Vec<[u32; 3]>,
     /// Whether the hull came from the cache.
     pub cached: bool,
+    /// The collider shape: the convex polyhedron of `points` (built once, shared by every world).
+    pub(crate) shape: SharedShape,
 }
 
 impl MeshHull {
-    /// The collider shape: the convex polyhedron of [`MeshHull::points`].
-    pub(crate) fn shape(&self) -> Option<SharedShape> {
-        let points = self.points.iter().map(|p| Vector::new(p[0], p[1], p[2])).collect();
-        SharedShape::convex_mesh(points, &self.triangles)
+    /// The hull of `points` and `triangles` with its collider shape, or an error if they enclose
+    /// no volume (rapier cannot build it, or it is flat: [`is_flat`]).
+    fn new(
+        path: &Path,
+        source_triangles: usize,
+        points: Vec<[f32; 3]>,
+        triangles: Vec<[u32; 3]>,
+        cached: bool,
+    ) -> Result<Self, String> {
+        let vertices = points.iter().map(|p| Vector::new(p[0], p[1], p[2])).collect();
+        let shape = SharedShape::convex_mesh(vertices, &triangles)
+            .filter(|_| !is_flat(&points, &triangles))
+            .ok_or("has no convex hull with a volume: is it flat?")?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            source_triangles,
+            points,
+            triangles,
+            cached,
+            shape,
+        })
     }
 }
 
@@ -104,14 +123,12 @@ fn package_root(name: &str, urdf_dir: &Path) -> Option<PathBuf> {
 pub fn load_hull(path: &Path, scale: [f64; 3], cache: Option<&Path>) -> Result<MeshHull, String> {
     let bytes = read_bounded(path)?;
     let key = cache::key(&bytes, scale);
-    if let Some((points, triangles, source_triangles)) = cache.and_then(|dir| cache::read(dir, &key)) {
-        return Ok(MeshHull {
-            path: path.to_path_buf(),
-            source_triangles,
-            points,
-            triangles,
-            cached: true,
-        });
+    let entry = cache.and_then(|dir| cache::read(dir, &key));
+    // An entry whose hull has no volume is damaged: ignored like any other, and rewritten.
+    if let Some(hit) =
+        entry.and_then(|(points, triangles, source)| MeshHull::new(path, source, points, triangles, true).ok())
+    {
+        return Ok(hit);
     }
     let made = hull_of_bytes(&bytes, path, scale)?;
     if let Some(dir) = cache {
@@ -126,17 +143,7 @@ pub fn hull_of_bytes(bytes: &[u8], path: &Path, scale: [f64; 3]) -> Result<MeshH
     let (points, source_triangles) = read_points(bytes, path, scale)?;
     let (hull, triangles) = try_convex_hull(&points).map_err(|e| format!("has no convex hull ({e:?}): is it flat?"))?;
     let points: Vec<[f32; 3]> = hull.iter().map(|p| [p.x, p.y, p.z]).collect();
-    let made = MeshHull {
-        path: path.to_path_buf(),
-        source_triangles,
-        points,
-        triangles,
-        cached: false,
-    };
-    if made.shape().is_none() || is_flat(&made.points, &made.triangles) {
-        return Err("has no convex hull with a volume: is it flat?".to_string());
-    }
-    Ok(made)
+    MeshHull::new(path, source_triangles, points, triangles, false)
 }
 
 /// Whether a hull encloses (almost) no volume: less than 1e-9 of its bounding box's diagonal
