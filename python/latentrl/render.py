@@ -5,6 +5,7 @@ of a floating robot or the x–y view of a fixed one; needs matplotlib (the `[pl
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -37,43 +38,73 @@ def view_axes(task: Task) -> tuple[int, int]:
 def draw_task(task: Task, plant: _native.TaskPlant, size: int = 400) -> NDArray[np.uint8]:
     """An RGB image (size, size, 3) of the task's robot as the plant holds it now."""
     fig, ax = _canvas(size)
-    draw_scene(ax, task, np.asarray(plant.link_poses()))
+    draw_scene(ax, Scene.of(task), np.asarray(plant.link_poses()))
     return _pixels(fig)
 
 
-def draw_scene(ax: Any, task: Task, poses: NDArray[np.float64], limits: tuple[Any, Any] | None = None) -> None:
-    """The task's robot at link poses `poses` (L, 7) on `ax`: its box, sphere, cylinder and
+@dataclass(frozen=True)
+class Scene:
+    """What a drawing of a task needs besides the link poses, read from the task once (a video
+    draws many frames of one scene)."""
+
+    view: tuple[int, int]
+    config: dict[str, Any]
+    link_names: tuple[str, ...]
+    edges: tuple[tuple[str, str], ...]
+    shapes: tuple[dict[str, Any], ...]
+    target: NDArray[np.float64]
+
+    @classmethod
+    def of(cls, task: Task) -> Scene:
+        config = task.to_dict()
+        target = np.asarray(config["target"]["position"], dtype=np.float64).reshape(-1, 3)
+        return cls(view_axes(task), config, tuple(task.link_names), tuple(task.edges),
+                   tuple(task._native.collision_shapes()), target)
+
+
+def view_limits(points: NDArray[np.float64]) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Square axis limits around 2-D `points` (K, 2), with a margin and at least ±0.2 m."""
+    low, high = points.min(axis=0), points.max(axis=0)
+    centre = (low + high) / 2
+    half = max(0.2, 0.6 * float((high - low).max()))
+    return (centre[0] - half, centre[0] + half), (centre[1] - half, centre[1] + half)
+
+
+def draw_scene(ax: Any, scene: Scene, poses: NDArray[np.float64], limits: tuple[Any, Any] | None = None) -> None:
+    """The scene's robot at link poses `poses` (L, 7) on `ax`: its box, sphere, cylinder and
     capsule collision shapes as solids, the kinematic tree as sticks, the obstacles, the floor
-    and the target, in `view_axes`; the view fits robot and target unless `limits` are given."""
+    and the target, in `scene.view`; the view fits robot and target unless `limits` are given."""
     from matplotlib.patches import Rectangle
 
-    a, b = view_axes(task)
-    config = task.to_dict()
-    positions = {name: pose[:3] for name, pose in zip(task.link_names, poses) if np.all(np.isfinite(pose))}
-    target = np.asarray(config["target"]["position"], dtype=np.float64).reshape(-1, 3)
+    a, b = scene.view
+    config = scene.config
+    positions = {name: pose[:3] for name, pose in zip(scene.link_names, poses) if np.all(np.isfinite(pose))}
     if limits is None:
-        # The view: the robot and the target, with a margin (the obstacles may reach beyond it).
-        points = np.vstack([*positions.values(), target])[:, [a, b]]
-        low, high = points.min(axis=0), points.max(axis=0)
-        centre = (low + high) / 2
-        half = max(0.2, 0.6 * float((high - low).max()))
-        limits = ((centre[0] - half, centre[0] + half), (centre[1] - half, centre[1] + half))
+        # The view: the robot and the target (the obstacles may reach beyond it).
+        limits = view_limits(np.vstack([*positions.values(), scene.target])[:, [a, b]])
     ax.set(xlim=limits[0], ylim=limits[1])
     for box in config["obstacles"]:
         lo, hi = _corners(box)
         ax.add_patch(Rectangle((lo[a], lo[b]), hi[a] - lo[a], hi[b] - lo[b], color="0.6"))
     if config["floor"] is not None and b == 2:
         ax.axhline(config["floor"]["height"], color="0.4", lw=2)
-    pose_of = dict(zip(task.link_names, poses))
-    for shape in task._native.collision_shapes():
+    pose_of = dict(zip(scene.link_names, poses))
+    for shape in scene.shapes:
         outline = shape_outline(pose_of[shape["link"]], shape, (a, b))
         if outline is not None:
             ax.fill(outline[:, 0], outline[:, 1], color="C0", alpha=0.35, lw=0)
-    for parent, child in task.edges:
+    for parent, child in scene.edges:
         if parent in positions and child in positions:
             p, c = positions[parent], positions[child]
             ax.plot([p[a], c[a]], [p[b], c[b]], "o-", color="C0", lw=2, ms=3)
-    ax.plot(target[:, a], target[:, b], "g*", ms=10)
+    ax.plot(scene.target[:, a], scene.target[:, b], "g*", ms=10)
+
+
+#: 16 points on the unit circle in the x–y plane, and those circles in the three axis planes
+#: (a sphere's outline seen from any axis).
+_ANGLES = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+_RING = np.column_stack([np.cos(_ANGLES), np.sin(_ANGLES), np.zeros_like(_ANGLES)])
+_BALL = np.vstack([_RING, _RING[:, [0, 2, 1]], _RING[:, [2, 0, 1]]])
 
 
 def shape_outline(link_pose: NDArray[np.float64], shape: Mapping[str, Any], view: tuple[int, int]) -> NDArray[np.float64] | None:
@@ -84,20 +115,14 @@ def shape_outline(link_pose: NDArray[np.float64], shape: Mapping[str, Any], view
     from scipy.spatial.transform import Rotation
 
     size = np.asarray(shape["size"], dtype=np.float64)
-    angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
-    ring = np.column_stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)])
     if shape["kind"] == "box":
         local = np.array([[(k >> i & 1) - 0.5 for i in range(3)] for k in range(8)]) * size
     elif shape["kind"] == "sphere":
-        sphere = np.vstack([ring, ring[:, [0, 2, 1]], ring[:, [2, 0, 1]]])
-        local = sphere * size[0]
+        local = _BALL * size[0]
     elif shape["kind"] in ("cylinder", "capsule"):
         radius, length = size
-        ends = [ring * radius + [0, 0, z] for z in (-length / 2, length / 2)]
-        if shape["kind"] == "capsule":
-            ends += [np.vstack([ring, ring[:, [0, 2, 1]], ring[:, [2, 0, 1]]]) * radius + [0, 0, z]
-                     for z in (-length / 2, length / 2)]
-        local = np.vstack(ends)
+        ends = _BALL if shape["kind"] == "capsule" else _RING
+        local = np.vstack([ends * radius + [0, 0, z] for z in (-length / 2, length / 2)])
     else:
         return None
     origin = np.asarray(shape["origin"], dtype=np.float64)

@@ -71,7 +71,7 @@ def render_frames(task: Any, model: Any, box: tuple[NDArray[np.float64], NDArray
     from matplotlib.figure import Figure
 
     from latentrl.plots import latent_value_panel
-    from latentrl.render import draw_scene, view_axes
+    from latentrl.render import Scene, draw_scene, view_limits
 
     slices = task.row_slices()
     base = rows[:, np.r_[slices["base_position"], slices["base_quaternion"]]]
@@ -79,17 +79,14 @@ def render_frames(task: Any, model: Any, box: tuple[NDArray[np.float64], NDArray
     latent = model.transform(joints)
     plant = task.plant()
     poses = [np.asarray(plant.pose_links(b, q)) for b, q in zip(base, joints)]
-    a, b = view_axes(task)
-    every = np.vstack([p[:, :3] for p in poses])[:, [a, b]]
-    every = every[np.isfinite(every).all(axis=1)]
-    low, high = every.min(axis=0), every.max(axis=0)
-    centre, half = (low + high) / 2, max(0.2, 0.6 * float((high - low).max()))
-    limits = ((centre[0] - half, centre[0] + half), (centre[1] - half, centre[1] + half))
+    scene = Scene.of(task)
+    every = np.vstack([p[:, :3] for p in poses])[:, list(scene.view)]
+    limits = view_limits(every[np.isfinite(every).all(axis=1)])  # one view for the whole episode
 
     fig = Figure(figsize=(size[0] / 100, size[1] / 100), dpi=100)
     FigureCanvasAgg(fig)
     robot, value = fig.add_subplot(1, 2, 1, aspect="equal"), fig.add_subplot(1, 2, 2)
-    latent_value_panel(value, weights, box[0], box[1], model, learner=task.to_dict()["learner"], grid=60)
+    latent_value_panel(value, weights, box[0], box[1], model, learner=scene.config["learner"], grid=60)
     trace, = value.plot([], [], "-", color="w", lw=1.5)
     point, = value.plot([], [], "o", color="r", ms=6)
     fig.suptitle(title, fontsize=9)
@@ -98,7 +95,7 @@ def render_frames(task: Any, model: Any, box: tuple[NDArray[np.float64], NDArray
     frames = []
     for step in picks:
         robot.cla()
-        draw_scene(robot, task, poses[step], limits)
+        draw_scene(robot, scene, poses[step], limits)
         robot.set_title(f"step {step} of {len(rows) - 1}", fontsize=8)
         trace.set_data(latent[: step + 1, 0], latent[: step + 1, 1])
         point.set_data([latent[step, 0]], [latent[step, 1]])
