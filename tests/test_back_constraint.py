@@ -88,3 +88,18 @@ def test_the_experiments_take_the_encoder_as_a_checked_preset_field(model):
     with pytest.raises(ValueError, match="encoder: expected one of gp, back_constrained, got 'projection'"):
         Exp2Preset(encoder="projection").validate()
     assert gplvm_info(model)["encoder"] == "back_constrained"
+
+
+def test_bad_inputs_to_the_native_back_constraint_are_named_errors(X):
+    from latentrl import InvalidInputError
+    from latentrl._native import GpMap
+
+    centred = X - X.mean(axis=0)
+    with pytest.raises(InvalidInputError, match="back-constraint weights"):
+        gplvm_back_constrained_nll_grad(np.zeros((5, 2)), centred, np.zeros(3), 0.0)
+    with pytest.raises(InvalidInputError, match="log beta"):
+        gplvm_back_constrained_nll_grad(np.zeros((len(X), 2)), centred, np.zeros(3), float("nan"))
+    with pytest.raises(InvalidInputError, match="theta2"):
+        gplvm_back_constrained_nll_grad(np.zeros((len(X), 2)), centred, np.zeros(3), 800.0)  # exp overflows
+    with pytest.raises(InvalidInputError, match="weights"):
+        GpMap.back_constraint(X, np.zeros((3, 2)), 0.0)

@@ -27,17 +27,21 @@ TASK_PREFIX = "task:"
 """Prefix of the argparse destinations of task keys (`task:learner.alpha`)."""
 
 
-def saved_run(out_dir: Path) -> tuple[str, Any]:
-    """(experiment name, preset) of the RL run in `out_dir`, from its results.json; ValueError if
-    the directory holds none, or the preset does not fit this version."""
+def saved_run(out_dir: Path, *, train: bool = False) -> tuple[str, Any]:
+    """(experiment name, preset) of the RL run in `out_dir`, from its results.json — with `train`,
+    also ("train", its TrainRun) for a `latentrl train` directory; ValueError if the directory
+    holds none, or the preset does not fit this version."""
     meta_path = out_dir / "results.json"
     if not meta_path.is_file():
         raise ValueError(f"{out_dir}: no results.json there, so no run of an RL experiment")
     fields = dict(read_json(meta_path).get("preset") or {})
     preset_name = fields.pop("name", None)
-    found = [
-        (name, exp.preset) for name, exp in experiments().items() if exp.rl and exp.preset.__name__ == preset_name
-    ]
+    known = [(name, exp.preset) for name, exp in experiments().items() if exp.rl]
+    if train:
+        from latentrl.experiments.training import TrainRun
+
+        known.append(("train", TrainRun))
+    found = [(name, cls) for name, cls in known if cls.__name__ == preset_name]
     if not found:
         raise ValueError(f"{out_dir}: results.json names no RL experiment's preset (found {preset_name!r})")
     name, preset_cls = found[0]
@@ -346,24 +350,10 @@ def _sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-def _replayable_run(out_dir: Path) -> tuple[str, Any]:
-    """("train", its TrainRun) for a `latentrl train` directory, else `saved_run`."""
-    from latentrl.experiments.training import TrainRun
-
-    meta = out_dir / "results.json"
-    fields = dict(read_json(meta).get("preset") or {}) if meta.is_file() else {}
-    if fields.pop("name", None) == TrainRun.__name__:
-        unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(TrainRun)})
-        if unknown:
-            raise ValueError(f"{out_dir}: its preset has fields this version does not know: {unknown}")
-        return "train", TrainRun(**fields)
-    return saved_run(out_dir)
-
-
 def _replay(args: argparse.Namespace) -> int:
     from latentrl.replay import replay
 
-    name, preset = _replayable_run(args.results)
+    name, preset = saved_run(args.results, train=True)
     what = replay(args.results, name, preset, args.out, trial=args.trial, episode=args.episode, test=args.test,
                   fps=args.fps, width=args.width, max_frames=args.max_frames)
     print(f"{what} in {args.out}")

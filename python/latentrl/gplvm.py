@@ -88,8 +88,8 @@ class GPLVM(Estimator):
         θ of the encoder: the out-of-sample GP's, or the back-constraint's (1, β, 1e-8).
     encoder_weights_ : ndarray (N, d)
         The back-constraint's weights W (zeros for the other encoders).
-    back_constrained_ : bool
-        Whether the fit was back-constrained.
+    fitted_encoder_ : {"gp", "back_constrained"}
+        Which encoder the fit made (`encoder_`); "projection" fits the "gp" model.
     decoder_ : GpMap
         Z → posture (Eq. 4).
     encoder_ : GpMap
@@ -218,7 +218,7 @@ class GPLVM(Estimator):
     def _build(self) -> None:
         self.log_likelihood_ = -self.nll_
         self.decoder_ = GpMap(self.Z_, self.X_train_, self.theta_)
-        if self.back_constrained_:
+        if self.fitted_encoder_ == "back_constrained":
             log_beta = float(np.log(self.encoder_theta_[1]))
             self.encoder_ = GpMap.back_constraint(self.X_train_, self.encoder_weights_, log_beta)
         else:
@@ -226,10 +226,10 @@ class GPLVM(Estimator):
         self.projection_ = Projection(self.Z_, self.X_train_, self.theta_, self.decoder_.jitter)
 
     @property
-    def back_constrained_(self) -> bool:
-        """Whether the fitted model is back-constrained (its weights are never all zero; the
-        other encoders' are)."""
-        return bool(np.any(self.encoder_weights_))
+    def fitted_encoder_(self) -> str:
+        """Which encoder the fit made: "back_constrained" (its weights are never all zero; the
+        other encoders' are) or "gp"."""
+        return "back_constrained" if np.any(self.encoder_weights_) else "gp"
 
     def _restore(self, state: dict[str, Any]) -> None:
         # Files written before the back-constraint have no weights: their encoders had none.
@@ -258,7 +258,7 @@ class GPLVM(Estimator):
         self._check_fitted()
         method = self.encoder if method is None else method
         self._check_encoder(method)
-        fitted = "back_constrained" if self.back_constrained_ else "gp"
+        fitted = self.fitted_encoder_
         if method not in (fitted, "projection"):
             raise ValueError(f"method {method!r}: this GPLVM was fitted with the {fitted!r} encoder, "
                              f"so transform takes {fitted!r} or 'projection'")

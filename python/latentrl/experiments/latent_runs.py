@@ -36,7 +36,7 @@ def gplvm_info(model: GPLVM) -> dict[str, Any]:
         "theta": model.theta_,
         "converged": model.converged_,
         "n_iter": model.n_iter_,
-        "encoder": "back_constrained" if model.back_constrained_ else "gp",
+        "encoder": model.fitted_encoder_,
         "encoder_theta": model.encoder_theta_,
     }
 
