@@ -6,7 +6,7 @@ export CARGO_TARGET_DIR ?= $(CURDIR)/target
 
 INSTALL_VENV := target/install-check-venv
 
-.PHONY: help demo test test-all bench figures lint build wheel install-check fuzz fuzz-py clean
+.PHONY: help demo test test-all bench figures docs lint build wheel install-check fuzz fuzz-py clean
 .DEFAULT_GOAL := help
 
 help: ## list the targets
@@ -15,7 +15,7 @@ help: ## list the targets
 $(VENV)/.deps: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib "imageio>=2.31" "imageio-ffmpeg>=0.5" tqdm gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm scikit-learn pandas "ray>=2.9"
+	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib "imageio>=2.31" "imageio-ffmpeg>=0.5" "moviepy>=2" "rerun-sdk>=0.23" tqdm gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm scikit-learn pandas "ray>=2.9"
 	touch $@
 
 # The old extension is unlinked first: maturin would overwrite it in place, under the feet of a
@@ -36,11 +36,20 @@ test: lint ## clippy, stub check, Rust tests (pure crates and the binding's pani
 	cargo test --quiet -p latentrl_py --lib
 	$(PY) -m pytest -q
 	$(MAKE) --no-print-directory install-check
+	$(MAKE) --no-print-directory docs
 
 # The [sb3] extra's package, installed by name: `pip install -e ".[sb3]"` would rebuild the native module.
 $(VENV)/.sb3: $(VENV)/.deps
 	$(PY) -m pip install --quiet "stable-baselines3>=2.3"
 	touch $@
+
+# The [docs] extra's packages, installed by name like the [sb3] extra's above.
+$(VENV)/.docs: $(VENV)/.deps
+	$(PY) -m pip install --quiet "mkdocs>=1.6" "mkdocstrings[python]>=1.0"
+	touch $@
+
+docs: build $(VENV)/.docs ## the documentation site into target/site/ (MkDocs, warnings are errors: broken links, anchors, references)
+	$(PY) -m mkdocs build --strict --site-dir target/site
 
 test-all: lint $(VENV)/.sb3 ## everything, slow reproductions and the SB3 example included (installs the [sb3] extra, ≈ 3 GB)
 	cargo test --quiet

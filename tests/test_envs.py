@@ -264,3 +264,28 @@ def test_bad_arguments():
     pca = PCA().fit(bimanual_pairs(20, np.random.default_rng(0)))
     with pytest.raises(ValueError, match="predict_variance"):
         LatentSpaceWrapper(BimanualReachEnv(), pca, variance_threshold=0.1)
+
+
+# moviepy's writer leaves its ffmpeg pipe to the garbage collector (a ResourceWarning of theirs).
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+@pytest.mark.parametrize("env_id", IDS)
+def test_record_video_writes_an_episode_of_every_env(env_id, tmp_path):
+    """Gymnasium's RecordVideo (moviepy) records `rgb_array` frames of every latentrl env: an
+    episode of 3 steps becomes an MP4 of its 4 frames (the reset's and each step's)."""
+    pytest.importorskip("moviepy")
+    iio = pytest.importorskip("imageio.v3")
+    from gymnasium.wrappers import RecordVideo
+
+    env = RecordVideo(gym.make(env_id, render_mode="rgb_array", max_episode_steps=3), str(tmp_path / "videos"),
+                      episode_trigger=lambda episode: True, disable_logger=True)
+    env.reset(seed=0)
+    done = False
+    while not done:
+        _, _, terminated, truncated, _ = env.step(np.zeros(env.action_space.shape))
+        done = terminated or truncated
+    env.close()
+    videos = sorted((tmp_path / "videos").glob("*.mp4"))
+    assert len(videos) == 1
+    frames = iio.imread(videos[0])
+    assert frames.shape[0] == 4 and frames.shape[3] == 3
+    assert frames.std() > 0  # a picture, not a blank frame

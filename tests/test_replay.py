@@ -1,5 +1,6 @@
-"""`latentrl replay` (issue #23): a recorded episode of an Exp 2 or Exp 3 run as a GIF or MP4,
-drawn from the stored path; bad requests exit 1 naming the problem and write nothing."""
+"""`latentrl replay` (issue #23): a recorded episode of an Exp 1, Exp 2, Exp 3 or train run as a
+GIF or MP4, or a Rerun recording, drawn from the stored path; bad requests exit 1 naming the
+problem and write nothing."""
 
 import subprocess
 import sys
@@ -13,6 +14,7 @@ from latentrl.cli import main  # noqa: E402
 
 EXP3 = ["run", "exp3", "--quick", "--trials", "1", "--episodes", "4", "--episode.max-steps", "12",
         "--test-episodes", "2", "--no-progress"]
+EXP1 = ["run", "exp1", "--quick", "--trials", "1", "--episodes", "3", "--plant.max-steps", "15", "--no-progress"]
 EXP2 = ["run", "exp2", "--quick", "--trials", "1", "--episodes", "2", "--episode.max-steps", "10",
         "--test-episodes", "1", "--fig5-samples", "50", "--gplvm-max-iter", "20", "--no-progress"]
 
@@ -22,6 +24,7 @@ def runs(tmp_path_factory):
     root = tmp_path_factory.mktemp("replay")
     assert main([*EXP3, "--out", str(root / "exp3")]) == 0
     assert main([*EXP2, "--out", str(root / "exp2")]) == 0
+    assert main([*EXP1, "--out", str(root / "exp1")]) == 0
     return root
 
 
@@ -75,3 +78,52 @@ def test_a_latentrl_train_run_on_a_custom_task_replays(tmp_path):
     out = tmp_path / "glass.gif"
     assert main(["replay", str(run), "--test", "0", "--out", str(out)]) == 0
     assert iio.imread(out).shape[1:] == (480, 960, 3)
+
+
+def test_a_training_episode_of_exp1s_latent_learner_becomes_a_gif(runs):
+    steps = int(np.load(runs / "exp1" / "returns.npz")["latent_steps"][0, 2])
+    out = runs / "toy.gif"
+    assert main(["replay", str(runs / "exp1"), "--episode", "2", "--out", str(out), "--width", "640"]) == 0
+    frames = iio.imread(out)
+    assert frames.shape == (steps + 1, 320, 640, 3)
+    assert not np.array_equal(frames[0], frames[-1])
+
+
+def _entities(path):
+    """Rows per entity path of a Rerun recording, read back with rerun-sdk's own reader."""
+    from collections import Counter
+
+    from rerun.chunk import RrdReader
+
+    rows = Counter()
+    for chunk in RrdReader(path).stream():
+        rows[str(chunk.entity_path)] += chunk.num_rows
+    return rows
+
+
+@pytest.mark.parametrize("run, what", [("exp3", ["--test", "0"]), ("exp1", ["--episode", "2"])])
+def test_a_rerun_recording_holds_every_step_of_the_robot_hands_and_latent_path(runs, tmp_path, run, what):
+    pytest.importorskip("rerun")
+    rows = np.load(runs / run / "returns.npz")
+    steps = int(rows["latent_test_steps"][0, 0] if what[0] == "--test" else rows["latent_steps"][0, 2]) + 1
+    out = tmp_path / "episode.rrd"
+    assert main(["replay", str(runs / run), *what, "--rerun", str(out)]) == 0
+    entities = _entities(out)
+    moving = ["/world/robot/boxes", "/world/robot/capsules", "/world/robot/tree"] if run == "exp3" else ["/world/robot/hands"]
+    for path in [*moving, "/world/effectors/0", "/world/effectors/1", "/latent/path", "/latent/point"]:
+        assert entities[path] == steps, path
+    for path in ["/world/obstacles", "/world/target", "/latent/value", "/latent/demos"]:
+        assert entities[path] == 1, path
+    assert list(tmp_path.iterdir()) == [out]  # no temporary file left
+
+
+def test_bad_rerun_requests_are_named(runs, tmp_path, capsys):
+    assert main(["replay", str(runs / "exp3"), "--test", "0", "--rerun", str(tmp_path / "x.rec")]) == 1
+    assert "--rerun " in capsys.readouterr().err
+    assert main(["replay", str(runs / "exp3"), "--test", "0"]) == 1
+    assert "give --out FILE.gif|FILE.mp4, --rerun FILE.rrd or both" in capsys.readouterr().err
+    code = ("import sys; sys.modules['rerun'] = None; from latentrl.cli import main; "
+            f"sys.exit(main(['replay', {str(runs / 'exp3')!r}, '--test', '0', '--rerun', {str(tmp_path / 'x.rrd')!r}]))")
+    err = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert err.returncode == 1 and "pip install 'latentrl[viewer]'" in err.stderr
+    assert list(tmp_path.iterdir()) == []

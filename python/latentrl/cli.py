@@ -182,9 +182,10 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--resume", action="store_true", help="continue the sweep in --out; finished trials are kept")
     sweep.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     sub.add_parser("info", help="print versions, git revision and thread count as JSON")
-    replay = sub.add_parser("replay", help="render a recorded episode of an Exp 2, Exp 3 or latentrl train run to a GIF or MP4 (the [video] extra)")
-    replay.add_argument("results", type=Path, help="a results directory of latentrl run exp2|exp3 or latentrl train")
-    replay.add_argument("--out", type=Path, required=True, help="the video: FILE.gif or FILE.mp4")
+    replay = sub.add_parser("replay", help="render a recorded episode of an Exp 1, Exp 2, Exp 3 or latentrl train run to a GIF or MP4 (the [video] extra) or a Rerun recording (the [viewer] extra)")
+    replay.add_argument("results", type=Path, help="a results directory of latentrl run exp1|exp2|exp3 or latentrl train")
+    replay.add_argument("--out", type=Path, help="the video: FILE.gif or FILE.mp4")
+    replay.add_argument("--rerun", type=Path, help="a Rerun recording FILE.rrd (view it with `rerun FILE.rrd`)")
     which = replay.add_mutually_exclusive_group(required=True)
     which.add_argument("--episode", type=int, help="a recorded training episode (the first, 10 %%, 50 %% and the last three)")
     which.add_argument("--test", type=int, help="a recorded frozen test episode (the first ten)")
@@ -354,9 +355,9 @@ def _replay(args: argparse.Namespace) -> int:
     from latentrl.replay import replay
 
     name, preset = saved_run(args.results, train=True)
-    what = replay(args.results, name, preset, args.out, trial=args.trial, episode=args.episode, test=args.test,
-                  fps=args.fps, width=args.width, max_frames=args.max_frames)
-    print(f"{what} in {args.out}")
+    what = replay(args.results, name, preset, args.out, rerun=args.rerun, trial=args.trial, episode=args.episode,
+                  test=args.test, fps=args.fps, width=args.width, max_frames=args.max_frames)
+    print(what)
     return 0
 
 
@@ -393,6 +394,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         out = getattr(args, "out", None)
         if out is not None:
             _check_writable(out, file=args.command in ("fit", "replay"))
+        if getattr(args, "rerun", None) is not None:
+            _check_writable(args.rerun, file=True)
         return command[args.command](args)
     except (ValueError, OSError) as err:
         print(f"latentrl: error: {err}", file=sys.stderr)

@@ -79,6 +79,14 @@ def hand_paths(
 Regions = Callable[[Axes, NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]], None]
 
 
+def variance_shade(variance: NDArray[np.float64]) -> NDArray[np.float64]:
+    """GPLVM variances as shades in [0, 1] (darkest the highest), on a log scale: the variance
+    spans orders of magnitude from the demonstrations to the corners of the latent box."""
+    log_var: NDArray[np.float64] = np.log(np.maximum(variance, 1e-300))
+    shade: NDArray[np.float64] = (log_var - log_var.min()) / max(float(np.ptp(log_var)), 1e-12)
+    return shade
+
+
 def latent_value_panel(
     ax: Axes,
     weights: NDArray[np.float64],
@@ -102,9 +110,7 @@ def latent_value_panel(
     extent = (low[0], high[0], low[1], high[1])
     image = ax.imshow(value, origin="lower", extent=extent, aspect="auto", cmap="viridis")
     ax.figure.colorbar(image, ax=ax, label="V")
-    # Log scale: the variance spans orders of magnitude from the demonstrations to the corners.
-    log_var = np.log(np.maximum(variance, 1e-300))
-    shade = ((log_var - log_var.min()) / max(np.ptp(log_var), 1e-12)).reshape(shape)
+    shade = variance_shade(variance).reshape(shape)
     overlay = np.zeros((*shape, 4))
     overlay[..., 3] = 0.6 * shade
     ax.imshow(overlay, origin="lower", extent=extent, aspect="auto")

@@ -74,30 +74,61 @@ def draw_scene(ax: Any, scene: Scene, poses: NDArray[np.float64], limits: tuple[
     """The scene's robot at link poses `poses` (L, 7) on `ax`: its box, sphere, cylinder and
     capsule collision shapes as solids, the kinematic tree as sticks, the obstacles, the floor
     and the target, in `scene.view`; the view fits robot and target unless `limits` are given."""
+    if limits is None:
+        # The view: the robot and the target (the obstacles may reach beyond it).
+        a, b = scene.view
+        links = poses[np.isfinite(poses).all(axis=1), :3]
+        limits = view_limits(np.vstack([links, scene.target])[:, [a, b]])
+    draw_backdrop(ax, scene, limits)
+    RobotArtists(ax, scene).update(poses)
+
+
+def draw_backdrop(ax: Any, scene: Scene, limits: tuple[Any, Any]) -> None:
+    """What does not move in a drawing of the scene: the view, obstacles, floor and target."""
     from matplotlib.patches import Rectangle
 
     a, b = scene.view
     config = scene.config
-    positions = {name: pose[:3] for name, pose in zip(scene.link_names, poses) if np.all(np.isfinite(pose))}
-    if limits is None:
-        # The view: the robot and the target (the obstacles may reach beyond it).
-        limits = view_limits(np.vstack([*positions.values(), scene.target])[:, [a, b]])
     ax.set(xlim=limits[0], ylim=limits[1])
     for box in config["obstacles"]:
         lo, hi = _corners(box)
         ax.add_patch(Rectangle((lo[a], lo[b]), hi[a] - lo[a], hi[b] - lo[b], color="0.6"))
     if config["floor"] is not None and b == 2:
         ax.axhline(config["floor"]["height"], color="0.4", lw=2)
-    pose_of = dict(zip(scene.link_names, poses))
-    for shape in scene.shapes:
-        outline = shape_outline(pose_of[shape["link"]], shape, (a, b))
-        if outline is not None:
-            ax.fill(outline[:, 0], outline[:, 1], color="C0", alpha=0.35, lw=0)
-    for parent, child in scene.edges:
-        if parent in positions and child in positions:
-            p, c = positions[parent], positions[child]
-            ax.plot([p[a], c[a]], [p[b], c[b]], "o-", color="C0", lw=2, ms=3)
     ax.plot(scene.target[:, a], scene.target[:, b], "g*", ms=10)
+
+
+class RobotArtists:
+    """The robot's moving artists on `ax` (a solid per collision shape, the kinematic tree as
+    one stick line), moved by `update`: a video changes them, not the whole figure."""
+
+    def __init__(self, ax: Any, scene: Scene, *, animated: bool = False) -> None:
+        from matplotlib.patches import Polygon
+
+        self.scene = scene
+        self.solids = [ax.add_patch(Polygon(np.zeros((3, 2)), closed=True, color="C0", alpha=0.35, lw=0,
+                                            animated=animated)) for _ in scene.shapes]
+        self.sticks, = ax.plot([], [], "o-", color="C0", lw=2, ms=3, animated=animated)
+
+    @property
+    def artists(self) -> list[Any]:
+        return [*self.solids, self.sticks]
+
+    def update(self, poses: NDArray[np.float64]) -> None:
+        """Moves the artists to link poses `poses` (L, 7); a link with a non-finite pose is left out."""
+        a, b = self.scene.view
+        pose_of = dict(zip(self.scene.link_names, poses))
+        for solid, shape in zip(self.solids, self.scene.shapes):
+            outline = shape_outline(pose_of[shape["link"]], shape, (a, b))
+            solid.set_visible(outline is not None)
+            if outline is not None:
+                solid.set_xy(outline)
+        finite = {name: pose[:3] for name, pose in pose_of.items() if np.all(np.isfinite(pose))}
+        gap = np.full(3, np.nan)
+        line = [point for parent, child in self.scene.edges if parent in finite and child in finite
+                for point in (finite[parent], finite[child], gap)]
+        xyz = np.array(line).reshape(-1, 3)
+        self.sticks.set_data(xyz[:, a], xyz[:, b])
 
 
 #: 16 points on the unit circle in the x–y plane, and those circles in the three axis planes
@@ -112,7 +143,6 @@ def shape_outline(link_pose: NDArray[np.float64], shape: Mapping[str, Any], view
     the `view` axes (the convex hull of its corners, or of points on its end circles); None for
     a mesh (drawn by its link's stick) or a shape seen edge-on."""
     from scipy.spatial import ConvexHull, QhullError
-    from scipy.spatial.transform import Rotation
 
     size = np.asarray(shape["size"], dtype=np.float64)
     if shape["kind"] == "box":
@@ -125,14 +155,23 @@ def shape_outline(link_pose: NDArray[np.float64], shape: Mapping[str, Any], view
         local = np.vstack([ends * radius + [0, 0, z] for z in (-length / 2, length / 2)])
     else:
         return None
-    origin = np.asarray(shape["origin"], dtype=np.float64)
-    world = Rotation.from_quat(link_pose[3:]).apply(Rotation.from_quat(origin[3:]).apply(local) + origin[:3]) + link_pose[:3]
-    flat = world[:, list(view)]
+    centre, rotation = shape_world_pose(link_pose, shape)
+    flat: NDArray[np.float64] = (rotation.apply(local) + centre)[:, list(view)]
     try:
         hull = ConvexHull(flat)
     except QhullError:
         return None
     return flat[hull.vertices]
+
+
+def shape_world_pose(link_pose: NDArray[np.float64], shape: Mapping[str, Any]) -> tuple[NDArray[np.float64], Any]:
+    """A collision shape's centre in the world and its rotation (a scipy `Rotation`), from its
+    link's pose (x, y, z, qx, qy, qz, qw) and its `origin` in the link."""
+    from scipy.spatial.transform import Rotation
+
+    origin = np.asarray(shape["origin"], dtype=np.float64)
+    link = Rotation.from_quat(link_pose[3:])
+    return link.apply(origin[:3]) + link_pose[:3], link * Rotation.from_quat(origin[3:])
 
 
 def _corners(box: Mapping[str, Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -145,11 +184,16 @@ def _corners(box: Mapping[str, Any]) -> tuple[NDArray[np.float64], NDArray[np.fl
 
 def draw_bimanual(config: Mapping[str, Any], hands: NDArray[np.float64], size: int = 400) -> NDArray[np.uint8]:
     """An RGB image of Experiment 1's toy: the hands, the target and the disc obstacle."""
+    fig, ax = _canvas(size)
+    draw_toy_backdrop(ax, config)
+    ax.plot(*np.asarray(hands).reshape(2, 2).T, "o-", color="C0", lw=3)
+    return _pixels(fig)
+
+
+def draw_toy_backdrop(ax: Any, config: Mapping[str, Any]) -> None:
+    """What does not move in Experiment 1's toy: its state box, the disc obstacle and the target."""
     from matplotlib.patches import Circle
 
-    fig, ax = _canvas(size)
     ax.set(xlim=(config["box_low"], config["box_high"]), ylim=(config["box_low"], config["box_high"]))
     ax.add_patch(Circle(tuple(config["obstacle_centre"]), config["obstacle_radius"], color="0.6"))
     ax.plot(*np.asarray(config["target"]).reshape(2, 2).T, "g*", ms=10)
-    ax.plot(*np.asarray(hands).reshape(2, 2).T, "o-", color="C0", lw=3)
-    return _pixels(fig)

@@ -7,6 +7,7 @@ path. GIF with Pillow, MP4 with the ffmpeg that imageio-ffmpeg ships: the `[vide
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from importlib import import_module
 from pathlib import Path
 from typing import Any
@@ -17,9 +18,9 @@ from numpy.typing import NDArray
 #: What `replay` writes, by suffix.
 FORMATS = (".gif", ".mp4")
 
-#: The runs that store robot paths: Exp 2, Exp 3 and `latentrl train` on any task (Exp 1's toy
-#: stores hand positions only).
-REPLAYABLE = ("exp2", "exp3", "train")
+#: The runs that store episode paths: Exp 1's latent learner (the toy's hands), and the robots
+#: of Exp 2, Exp 3 and `latentrl train` on any task.
+REPLAYABLE = ("exp1", "exp2", "exp3", "train")
 
 
 def episode_path(arrays: dict[str, NDArray[Any]], trial: int, episode: int | None, test: int | None,
@@ -62,45 +63,107 @@ def check_output(out: Path) -> None:
         raise ValueError("videos need imageio and imageio-ffmpeg: pip install 'latentrl[video]'") from None
 
 
-def render_frames(task: Any, model: Any, box: tuple[NDArray[np.float64], NDArray[np.float64]],
-                  weights: NDArray[np.float64], rows: NDArray[np.float64], title: str,
-                  size: tuple[int, int] = (960, 480), max_frames: int = 400) -> NDArray[np.uint8]:
-    """RGB frames (T, height, width, 3): the robot at each stored row (left) and V over the
-    latent box with the path of the encoded postures (right)."""
+@dataclass(frozen=True)
+class Recorded:
+    """One recorded episode and what drawing it needs: the effectors' path (T, E, 3), the
+    latent path (T, 2) on the learner's V (its final `weights` over the box [`low`, `high`]), and
+    either a robot (`scene` and link poses (T, L, 7)) or Exp 1's toy (its plant `toy`)."""
+
+    title: str
+    effectors: NDArray[np.float64]
+    latent: NDArray[np.float64]
+    weights: NDArray[np.float64]
+    low: NDArray[np.float64]
+    high: NDArray[np.float64]
+    model: Any
+    learner: dict[str, Any]
+    scene: Any = None
+    poses: NDArray[np.float64] | None = None
+    toy: dict[str, Any] | None = None
+
+
+def recorded(experiment: str, preset: Any, rows: NDArray[np.float64], weights: NDArray[np.float64],
+             title: str) -> Recorded:
+    """The episode of stored `rows` of a run of `experiment`, with the run's GPLVM refitted from
+    its saved preset (the fit is deterministic in it)."""
+    from latentrl.render import Scene
+
+    if experiment == "exp1":
+        from latentrl.experiments import exp1
+
+        fitted = exp1.fit(preset)
+        plant, learner = exp1.configs(preset)
+        hands = np.concatenate([rows.reshape(len(rows), 2, 2), np.zeros((len(rows), 2, 1))], axis=2)
+        return Recorded(title, hands, fitted.model.transform(rows), weights, fitted.low, fitted.high, fitted.model,
+                        learner, toy=plant)
+    task, model, (low, high) = run_setup(experiment, preset)
+    slices = task.row_slices()
+    joints = rows[:, slices["joints"]]
+    base = rows[:, np.r_[slices["base_position"], slices["base_quaternion"]]]
+    plant = task.plant()
+    poses = np.stack([np.asarray(plant.pose_links(b, q)) for b, q in zip(base, joints)])
+    scene = Scene.of(task)
+    return Recorded(f"{task.name}: {title}", rows[:, slices["effectors"]].reshape(len(rows), -1, 3),
+                    model.transform(joints), weights, low, high, model, scene.config["learner"], scene=scene,
+                    poses=poses)
+
+
+def render_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_frames: int = 400) -> NDArray[np.uint8]:
+    """RGB frames (T, height, width, 3): the robot (or Exp 1's hands) at each stored step (left)
+    and V over the latent box with the latent path so far (right). What does not move is drawn
+    once; each frame restores it and draws the moving artists on it (matplotlib's blitting)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     from latentrl.plots import latent_value_panel
-    from latentrl.render import Scene, draw_scene, view_limits
-
-    slices = task.row_slices()
-    base = rows[:, np.r_[slices["base_position"], slices["base_quaternion"]]]
-    joints = rows[:, slices["joints"]]
-    latent = model.transform(joints)
-    plant = task.plant()
-    poses = [np.asarray(plant.pose_links(b, q)) for b, q in zip(base, joints)]
-    scene = Scene.of(task)
-    every = np.vstack([p[:, :3] for p in poses])[:, list(scene.view)]
-    limits = view_limits(every[np.isfinite(every).all(axis=1)])  # one view for the whole episode
+    from latentrl.render import RobotArtists, draw_backdrop, draw_toy_backdrop, view_limits
 
     fig = Figure(figsize=(size[0] / 100, size[1] / 100), dpi=100)
-    FigureCanvasAgg(fig)
-    robot, value = fig.add_subplot(1, 2, 1, aspect="equal"), fig.add_subplot(1, 2, 2)
-    latent_value_panel(value, weights, box[0], box[1], model, learner=scene.config["learner"], grid=60)
-    trace, = value.plot([], [], "-", color="w", lw=1.5)
-    point, = value.plot([], [], "o", color="r", ms=6)
-    fig.suptitle(title, fontsize=9)
+    canvas = FigureCanvasAgg(fig)
+    left, value = fig.add_subplot(1, 2, 1, aspect="equal"), fig.add_subplot(1, 2, 2)
+    latent_value_panel(value, episode.weights, episode.low, episode.high, episode.model, learner=episode.learner,
+                       grid=60)
+    trace, = value.plot([], [], "-", color="w", lw=1.5, animated=True)
+    point, = value.plot([], [], "o", color="r", ms=6, animated=True)
+    label = left.set_title("", fontsize=8)
+    label.set_animated(True)
+    if episode.poses is not None:
+        scene = episode.scene
+        every = episode.poses[..., :3].reshape(-1, 3)[:, list(scene.view)]
+        draw_backdrop(left, scene, view_limits(every[np.isfinite(every).all(axis=1)]))  # one view for the episode
+        robot = RobotArtists(left, scene, animated=True)
+        moving = [*robot.artists, trace, point, label]
+
+        def move(step: int) -> None:
+            robot.update(episode.poses[step])  # type: ignore[index]
+    else:
+        draw_toy_backdrop(left, episode.toy)  # type: ignore[arg-type]
+        hands, = left.plot([], [], "o-", color="C0", lw=3, animated=True)
+        paths = [left.plot([], [], "-", color="C0", lw=0.8, animated=True)[0] for _ in range(2)]
+        moving = [hands, *paths, trace, point, label]
+
+        def move(step: int) -> None:
+            now = episode.effectors[step]
+            hands.set_data(now[:, 0], now[:, 1])
+            for hand, path in enumerate(paths):
+                path.set_data(episode.effectors[: step + 1, hand, 0], episode.effectors[: step + 1, hand, 1])
+
+    fig.suptitle(episode.title, fontsize=9)
     fig.subplots_adjust(left=0.08, right=0.95, bottom=0.14, top=0.86, wspace=0.3)
-    picks = np.unique(np.linspace(0, len(rows) - 1, min(len(rows), max_frames)).round().astype(int))
+    canvas.draw()  # type: ignore[no-untyped-call]
+    background = canvas.copy_from_bbox(fig.bbox)  # type: ignore[no-untyped-call]
+    steps = len(episode.latent)
+    picks = np.unique(np.linspace(0, steps - 1, min(steps, max_frames)).round().astype(int))
     frames = []
     for step in picks:
-        robot.cla()
-        draw_scene(robot, scene, poses[step], limits)
-        robot.set_title(f"step {step} of {len(rows) - 1}", fontsize=8)
-        trace.set_data(latent[: step + 1, 0], latent[: step + 1, 1])
-        point.set_data([latent[step, 0]], [latent[step, 1]])
-        fig.canvas.draw()
-        frames.append(np.asarray(fig.canvas.buffer_rgba())[..., :3].copy())  # type: ignore[attr-defined]
+        canvas.restore_region(background)  # type: ignore[no-untyped-call]
+        move(step)
+        label.set_text(f"step {step} of {steps - 1}")
+        trace.set_data(episode.latent[: step + 1, 0], episode.latent[: step + 1, 1])
+        point.set_data([episode.latent[step, 0]], [episode.latent[step, 1]])
+        for artist in moving:
+            fig.draw_artist(artist)
+        frames.append(np.asarray(canvas.buffer_rgba())[..., :3].copy())  # type: ignore[no-untyped-call]
     return np.stack(frames)
 
 
@@ -134,29 +197,44 @@ def run_setup(experiment: str, preset: Any) -> tuple[Any, Any, tuple[NDArray[np.
     return module.task_of(preset), fit.model, (fit.low, fit.high)
 
 
-def replay(run_dir: Path, experiment: str, preset: Any, out: Path, *, trial: int = 0,
-           episode: int | None = None, test: int | None = None, fps: int = 20, width: int = 960,
+def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None, *, rerun: Path | None = None,
+           trial: int = 0, episode: int | None = None, test: int | None = None, fps: int = 20, width: int = 960,
            max_frames: int = 400) -> str:
-    """Renders one recorded episode of the run in `run_dir` (`experiment` "exp2", "exp3" or
-    "train", its saved `preset`) to `out`; returns what was rendered. Every argument is checked
-    before drawing."""
+    """Renders one recorded episode of the run in `run_dir` (`experiment` "exp1", "exp2", "exp3"
+    or "train", its saved `preset`) to the video `out` and/or the Rerun recording `rerun`;
+    returns what was rendered. Every argument is checked before drawing."""
     from latentrl.experiments.runner import load_arrays
 
     if experiment not in REPLAYABLE:
-        raise ValueError(f"{run_dir}: a run of {experiment}; replay draws robot runs (exp2, exp3, latentrl train)")
+        raise ValueError(f"{run_dir}: a run of {experiment}; replay draws runs of {', '.join(REPLAYABLE[:-1])} "
+                         "and latentrl train")
+    if out is None and rerun is None:
+        raise ValueError("give --out FILE.gif|FILE.mp4, --rerun FILE.rrd or both")
     if (episode is None) == (test is None):
         raise ValueError("give one of --episode E (a recorded training episode) or --test T (a frozen test episode)")
     for flag, value, least in (("--fps", fps, 1), ("--width", width, 200), ("--max-frames", max_frames, 2)):
         if value < least:
             raise ValueError(f"{flag} must be at least {least}, got {value}")
-    check_output(out)
+    if out is not None:
+        check_output(out)
+    if rerun is not None:
+        from latentrl.rerun_log import check_rerun_output
+
+        check_rerun_output(rerun)
     arrays = load_arrays(run_dir)
     rows, what = episode_path(arrays, trial, episode, test, preset.episodes)
     weights = arrays.get("latent_weights")
     if weights is None:
         raise ValueError(f"{run_dir}: the run kept no learnt weights to draw V from")
-    task, model, box = run_setup(experiment, preset)
-    frames = render_frames(task, model, box, np.asarray(weights)[trial], rows, f"{task.name}: {what}",
-                           size=(width, width // 2), max_frames=max_frames)
-    write_video(frames, out, fps)
-    return f"{what}: {len(frames)} frames"
+    drawn = recorded(experiment, preset, rows, np.asarray(weights)[trial], what)
+    done = []
+    if out is not None:
+        frames = render_frames(drawn, size=(width, width // 2), max_frames=max_frames)
+        write_video(frames, out, fps)
+        done.append(f"{len(frames)} frames in {out}")
+    if rerun is not None:
+        from latentrl.rerun_log import write_rerun
+
+        write_rerun(drawn, rerun)
+        done.append(f"a Rerun recording of {len(rows)} steps in {rerun}")
+    return f"{what}: {' and '.join(done)}"

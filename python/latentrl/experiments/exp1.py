@@ -17,10 +17,9 @@ import numpy as np
 
 from latentrl import _native
 from latentrl.datasets import bimanual_pairs
-from latentrl.experiments.latent_runs import gplvm_info, recorded_episodes
-from latentrl.experiments.presets import LatentRun, check_ints, latent_box
+from latentrl.experiments.latent_runs import Fitted, gplvm_info, recorded_episodes
+from latentrl.experiments.presets import LatentRun, check_ints
 from latentrl.experiments.runner import RunTrials, Setup
-from latentrl.gplvm import GPLVM
 
 
 @dataclass(frozen=True)
@@ -58,13 +57,19 @@ def configs(preset: Exp1Preset) -> tuple[dict[str, Any], dict[str, Any]]:
     return plant, learner
 
 
-def setup(preset: Exp1Preset) -> Setup:
-    """Demonstrations, the GPLVM and its latent box, and both learners' trial runners."""
-    plant, learner = configs(preset)
+def fit(preset: Exp1Preset) -> Fitted:
+    """The demonstrated hand pairs (seeded by `preset.seed`), the GPLVM and its latent box."""
     demos = bimanual_pairs(preset.n_demos, np.random.default_rng(preset.seed))
-    model = GPLVM(n_components=2, max_iter=preset.gplvm_max_iter, random_state=preset.seed,
-                  encoder=preset.encoder).fit(demos)
-    low, high = latent_box(model.Z_, preset.latent_margin)
+    return Fitted.of(demos, seed=preset.seed, max_iter=preset.gplvm_max_iter, margin=preset.latent_margin,
+                     encoder=preset.encoder)
+
+
+def setup(preset: Exp1Preset) -> Setup:
+    """Demonstrations, the GPLVM and its latent box, and both learners' trial runners (the
+    latent learner's final weights are kept: `latentrl replay` draws its V)."""
+    plant, learner = configs(preset)
+    fitted = fit(preset)
+    model, low, high = fitted.model, fitted.low, fitted.high
     run = partial(
         _native.run_bimanual_trials,
         episodes=preset.episodes,
@@ -74,7 +79,8 @@ def setup(preset: Exp1Preset) -> Setup:
         record_episodes=recorded_episodes(preset.episodes),
     )
     learners: dict[str, RunTrials] = {
-        "latent": partial(run, decoder=model.decoder_, encoder=model.encoder_, latent_low=low, latent_high=high),
+        "latent": partial(run, decoder=model.decoder_, encoder=model.encoder_, latent_low=low, latent_high=high,
+                          return_weights=True),
         "full": run,
     }
     info = {

@@ -18,16 +18,13 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from latentrl.datasets import arm_postures
-from latentrl.experiments.latent_runs import latent_setup
-from latentrl.experiments.presets import LatentRun, check_ints, latent_box
+from latentrl.experiments.latent_runs import Fitted, latent_setup
+from latentrl.experiments.presets import LatentRun, check_ints
 from latentrl.experiments.runner import Setup
-from latentrl.gplvm import GPLVM
 from latentrl.task import Task
 
 GRIP_TEST_TOLERANCE = 0.005
@@ -72,16 +69,6 @@ def task_of(preset: Exp2Preset) -> Task:
     return Task.shipped("two_arms").replace(preset.task)
 
 
-@dataclass(frozen=True)
-class Fitted:
-    """The demonstrations, the GPLVM fitted to them and the latent box of the learner."""
-
-    demos: NDArray[np.float64]
-    model: GPLVM
-    low: NDArray[np.float64]
-    high: NDArray[np.float64]
-
-
 def fit(preset: Exp2Preset) -> Fitted:
     """Demonstrations (seeded by `preset.seed`), GPLVM and latent box; cached on the fields
     they depend on, so `setup` and `figures` (and presets that differ elsewhere) share a fit."""
@@ -91,9 +78,7 @@ def fit(preset: Exp2Preset) -> Fitted:
 @lru_cache(maxsize=4)
 def _fit(n_demos: int, seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
     demos = arm_postures(n_demos, np.random.default_rng(seed))
-    model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder).fit(demos)
-    low, high = latent_box(model.Z_, margin)
-    return Fitted(demos, model, low, high)
+    return Fitted.of(demos, seed=seed, max_iter=max_iter, margin=margin, encoder=encoder)
 
 
 def setup(preset: Exp2Preset) -> Setup:

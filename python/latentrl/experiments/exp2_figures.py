@@ -14,8 +14,8 @@ from matplotlib.patches import Rectangle
 from numpy.typing import NDArray
 
 from latentrl.datasets import arms_forward, grip_error
-from latentrl.experiments.exp2 import GRIP_TEST_TOLERANCE, Exp2Preset, Fitted, fit, task_of
-from latentrl.experiments.latent_runs import recorded_episodes
+from latentrl.experiments.exp2 import GRIP_TEST_TOLERANCE, Exp2Preset, fit, task_of
+from latentrl.experiments.latent_runs import Fitted, recorded_episodes
 from latentrl.experiments.presets import latent_box
 from latentrl.pca import PCA
 from latentrl.plots import hand_paths, latent_run_figures, latent_value_panel, save_figure, shown_paths

@@ -22,16 +22,12 @@ from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
-from typing import Any
 
-import numpy as np
-from numpy.typing import NDArray
 
 from latentrl.demos import load_demos
-from latentrl.experiments.latent_runs import latent_setup
-from latentrl.experiments.presets import LatentRun, check_ints, latent_box
+from latentrl.experiments.latent_runs import Fitted, latent_setup
+from latentrl.experiments.presets import LatentRun, check_ints
 from latentrl.experiments.runner import Setup
-from latentrl.gplvm import GPLVM
 from latentrl.task import Task
 
 
@@ -80,16 +76,6 @@ def task_of(preset: Exp3Preset) -> Task:
     return Task.shipped("humanoid_lift").replace(preset.task)
 
 
-@dataclass(frozen=True)
-class Fitted:
-    """The demonstrations, the GPLVM fitted to them and the latent box of the learner."""
-
-    demos: NDArray[np.float64]
-    model: GPLVM
-    low: NDArray[np.float64]
-    high: NDArray[np.float64]
-
-
 def fit(preset: Exp3Preset) -> Fitted:
     """Demos, GPLVM and latent box; cached on the fields they depend on."""
     return _fit(preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder)
@@ -99,9 +85,7 @@ def fit(preset: Exp3Preset) -> Fitted:
 def _fit(seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
     joints = Task.shipped("humanoid_lift").joint_names
     demos = load_demos(demos_path(), expected_joints=joints).postures
-    model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder).fit(demos)
-    low, high = latent_box(model.Z_, margin)
-    return Fitted(demos, model, low, high)
+    return Fitted.of(demos, seed=seed, max_iter=max_iter, margin=margin, encoder=encoder)
 
 
 def setup(preset: Exp3Preset) -> Setup:

@@ -13,8 +13,8 @@ from matplotlib.axes import Axes
 from matplotlib.patches import Rectangle
 from numpy.typing import NDArray
 
-from latentrl.experiments.exp3 import Exp3Preset, Fitted, fit, task_of
-from latentrl.experiments.latent_runs import recorded_episodes
+from latentrl.experiments.exp3 import Exp3Preset, fit, task_of
+from latentrl.experiments.latent_runs import Fitted, recorded_episodes
 from latentrl.plots import (
     latent_run_figures,
     latent_value_panel,

@@ -17,7 +17,6 @@ import numpy as np
 from matplotlib.axes import Axes
 from numpy.typing import NDArray
 
-from latentrl import _native
 from latentrl.experiments.fallcheck import FallCheckPreset, fall_check, fit_coders, humanoid, segment_targets, segments
 from latentrl.plots import box_corners, link_positions, save_figure, side_view_stick
 

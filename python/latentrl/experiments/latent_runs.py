@@ -1,9 +1,10 @@
-"""What the latent-space experiments' setups share: which episodes keep their paths, the fitted
-GPLVM's metadata for the results, and the native trial runner bound to a task, a GPLVM and its
-latent box."""
+"""What the latent-space experiments' setups share: the GPLVM fit and its latent box, which
+episodes keep their paths, the fitted GPLVM's metadata for the results, and the native trial
+runner bound to a task, a GPLVM and its latent box."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
@@ -11,9 +12,27 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl import _native
+from latentrl.experiments.presets import latent_box
 from latentrl.experiments.runner import RunTrials, Setup
 from latentrl.gplvm import GPLVM
 from latentrl.task import Task
+
+
+@dataclass(frozen=True)
+class Fitted:
+    """The demonstrations, the GPLVM (d = 2) fitted to them and the latent box of the learner."""
+
+    demos: NDArray[np.float64]
+    model: GPLVM
+    low: NDArray[np.float64]
+    high: NDArray[np.float64]
+
+    @classmethod
+    def of(cls, demos: NDArray[np.float64], *, seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
+        """The fit of `demos` (deterministic in `seed`) and its box with `margin` per side."""
+        model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder).fit(demos)
+        low, high = latent_box(model.Z_, margin)
+        return cls(demos, model, low, high)
 
 
 def recorded_episodes(episodes: int) -> list[int]:
