@@ -235,6 +235,8 @@ def test_params_and_repr():
         "random_state",
         "encoder",
         "tol",
+        "max_components",
+        "relevance_threshold",
     }
 
 

@@ -181,7 +181,7 @@ class Estimator:
     _saved: ClassVar[SavedSpec] = {}
 
     #: Fitted attributes (see `fit`); declared for type checkers.
-    n_components: int
+    n_components: int | str
     n_features_in_: int
     feature_names_in_: NDArray[np.object_]
 
@@ -205,6 +205,12 @@ class Estimator:
     def _n_features_out(self) -> int:
         """Latent dimension of the fitted model."""
         raise NotImplementedError
+
+    @property
+    def n_components_(self) -> int:
+        """The fitted latent dimension d (`n_components`, or what "auto" chose)."""
+        self._check_fitted()
+        return self._n_features_out
 
     @classmethod
     def _param_names(cls) -> list[str]:
@@ -306,7 +312,8 @@ class Estimator:
 
     def _restore(self, state: dict[str, Any]) -> None:
         """Sets the saved attributes after checking them against `_saved`, then `_build`s."""
-        sizes = {"d": self.n_components}
+        # "d" is n_components, or for n_components="auto" what the saved latent points have.
+        sizes = {"d": self.n_components} if isinstance(self.n_components, int) else {}
         if "n_features_in_" in state:
             sizes["D"] = int(state["n_features_in_"])
         for name, (kind, shape) in self._saved.items():

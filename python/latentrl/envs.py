@@ -322,7 +322,7 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
                 raise ValueError("variance_threshold needs a model with predict_variance (GPLVM)")
             if not (np.isfinite(variance_threshold) and variance_threshold > 0):
                 raise ValueError(f"variance_threshold must be > 0, got {variance_threshold!r}")
-        d = int(model.n_components)
+        d = int(model.n_components_)
         if latent_box is None:
             if hasattr(model, "Z_"):
                 z = np.asarray(model.Z_)

@@ -33,8 +33,18 @@ class GPLVM(Estimator):
 
     Parameters
     ----------
-    n_components : int, default=2
-        Latent dimension d.
+    n_components : int or "auto", default=2
+        Latent dimension d. "auto" chooses it from the data by automatic relevance: a fit
+        with `max_components` dimensions gives each principal axis of its latent points a
+        relevance, the inverse squared length scale an ARD kernel would give it (the axis's
+        variance over θ2); d is the number of axes whose relevance is at least
+        `relevance_threshold` of the largest, and the model is then fitted with that d
+        (`relevance_` keeps the evidence; docs/encoders.md).
+    max_components : int, default=5
+        With n_components="auto": the dimension of the first fit (less than the number of
+        joints and of postures).
+    relevance_threshold : float, default=0.1
+        With n_components="auto": the least relative relevance of a kept latent axis.
     max_iter : int, default=1000
         L-BFGS-B iteration cap per start. If it is hit, `converged_` is False.
     noise_floor : float, default=1e-6
@@ -65,6 +75,12 @@ class GPLVM(Estimator):
     ----------
     Z_ : ndarray (N, d)
         Latent points of the training postures.
+    n_components_ : int
+        The fitted latent dimension d.
+    relevance_ : ndarray (K,)
+        Relevance of the principal axes of the latent points, largest first (an ARD
+        kernel's inverse squared length scales): of the `max_components` fit with
+        n_components="auto" (K = max_components), else of this fit (K = d).
     theta_ : ndarray (3,)
         Kernel parameters θ1 (signal variance), θ2 (squared length-scale), θ3 (noise).
     nll_ : float
@@ -128,6 +144,7 @@ class GPLVM(Estimator):
         "theta_": ("f", (3,)),
         "encoder_theta_": ("f", (3,)),
         "encoder_weights_": ("f", ("N", "d")),
+        "relevance_": ("f", ("K",)),
         "nll_": ("f", ()),
         "n_iter_": ("i", ()),
         "converged_": ("b", ()),
@@ -137,7 +154,7 @@ class GPLVM(Estimator):
 
     def __init__(
         self,
-        n_components: int = 2,
+        n_components: int | str = 2,
         max_iter: int = 1000,
         noise_floor: float = 1e-6,
         latent_prior: bool = False,
@@ -145,8 +162,12 @@ class GPLVM(Estimator):
         random_state: int | None = None,
         encoder: str = "gp",
         tol: float = 1e-6,
+        max_components: int = 5,
+        relevance_threshold: float = 0.1,
     ) -> None:
         self.n_components = n_components
+        self.max_components = max_components
+        self.relevance_threshold = relevance_threshold
         self.max_iter = max_iter
         self.noise_floor = noise_floor
         self.latent_prior = latent_prior
@@ -160,6 +181,10 @@ class GPLVM(Estimator):
         `y` is ignored. Returns self."""
         names = column_names(X)
         X = as_matrix("X", X)
+        if isinstance(self.n_components, str):
+            if self.n_components != "auto":
+                raise ValueError(f"n_components must be an int >= 1 or 'auto', got {self.n_components!r}")
+            return self._fit_auto(X, names)
         check_n_components(self.n_components, X)
         if len(X) > _native.MAX_GP_POINTS:
             raise ValueError(f"X: {len(X)} postures, more than the {_native.MAX_GP_POINTS} a GPLVM fit takes "
@@ -212,7 +237,30 @@ class GPLVM(Estimator):
             self.encoder_weights_ = np.zeros_like(self.Z_)
             encoder = fit_gp_encoder(X, self.Z_, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
         self.encoder_theta_ = np.array(encoder.theta)
+        self.relevance_ = latent_relevance(self.Z_, self.theta_)
         self._build()
+        return self
+
+    def _fit_auto(self, X: NDArray[np.float64], names: Any) -> Self:
+        """n_components="auto": the `max_components` fit's relevances choose d, then the fit
+        with d (module doc of `n_components`)."""
+        n, joints = X.shape
+        if n < 3:
+            raise ValueError(f"n_components='auto' needs at least 3 postures to compare latent axes, got {n}")
+        k = int_at_least("max_components", self.max_components, 1)
+        if k >= joints or k >= n:
+            raise ValueError(f"max_components must be less than the number of joints ({joints}) and of postures "
+                             f"({n}), got {k}")
+        threshold = positive("relevance_threshold", self.relevance_threshold)
+        if threshold > 1:
+            raise ValueError(f"relevance_threshold must be in (0, 1], got {threshold!r}")
+        params = {**self.get_params(), "max_components": k}
+        widest = GPLVM(**{**params, "n_components": k}).fit(X)
+        relevance = widest.relevance_
+        d = int(np.sum(relevance >= threshold * relevance[0]))
+        chosen = widest if d == k else GPLVM(**{**params, "n_components": d}).fit(X)
+        self._restore({**chosen._fitted_state(), "relevance_": relevance})
+        self._set_feature_names(names)
         return self
 
     def _build(self) -> None:
@@ -232,9 +280,13 @@ class GPLVM(Estimator):
         return "back_constrained" if np.any(self.encoder_weights_) else "gp"
 
     def _restore(self, state: dict[str, Any]) -> None:
-        # Files written before the back-constraint have no weights: their encoders had none.
-        if "encoder_weights_" not in state and "Z_" in state:
-            state = {**state, "encoder_weights_": np.zeros_like(np.asarray(state["Z_"], dtype=np.float64))}
+        # Files written before the back-constraint have no weights: their encoders had none;
+        # files written before n_components="auto" have no relevances: those of their own axes.
+        if "Z_" in state:
+            Z = np.asarray(state["Z_"], dtype=np.float64)
+            state = {"encoder_weights_": np.zeros_like(Z), **state}
+            if "relevance_" not in state and "theta_" in state:
+                state["relevance_"] = latent_relevance(Z, np.asarray(state["theta_"], dtype=np.float64))
         super()._restore(state)
 
     @staticmethod
@@ -290,3 +342,13 @@ class GPLVM(Estimator):
         """Predictive variance σ²(z) (M,) at latent points `Z` (M, d), θ3 included (Eq. 4)."""
         self._check_fitted()
         return self.decoder_.predict(as_matrix("Z", Z, n_cols=self._n_features_out))[1]
+
+
+def latent_relevance(Z: NDArray[np.float64], theta: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The principal axes' relevances of latent points `Z` (N, d) under kernel θ, largest
+    first: each axis's variance over θ2, the inverse squared length scale an ARD kernel on
+    unit-variance axes would have (the SE kernel is isotropic, so only the spread of Z along
+    an axis tells how much the fit uses it)."""
+    spread = np.linalg.eigvalsh(np.atleast_2d(np.cov(Z.T))) if Z.shape[1] > 1 else np.array([np.var(Z, ddof=1)])
+    relevance: NDArray[np.float64] = np.sort(np.maximum(spread, 0.0))[::-1] / theta[1]
+    return relevance

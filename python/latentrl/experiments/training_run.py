@@ -33,7 +33,7 @@ def figures(run: TrainRun, arrays: Mapping[str, np.ndarray], out: Path) -> None:
     learning_curves(ax, {"latent": arrays["latent"]}, window=max(1, min(100, run.episodes // 5)))
     ax.set_title(f"{task.name}: return per episode, mean ± s.d. over trials")
     save_figure(fig, out, "returns")
-    if model.n_components != 2 or "latent_weights" not in arrays:
+    if model.n_components_ != 2 or "latent_weights" not in arrays:
         return
     low, high = latent_box(model.Z_, run.latent_margin)
     before = np.full(int(learner["rbf_per_dim"]) ** 2, float(learner["initial_weight"]))
