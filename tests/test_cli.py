@@ -244,6 +244,27 @@ def test_fit_saves_the_model_a_fit_in_python_gives(tmp_path, model):
     np.testing.assert_array_equal(loaded.transform(postures), expected.transform(postures))
 
 
+def test_fit_auto_chooses_the_dimension_and_names_bad_values(tmp_path):
+    from latentrl import GPLVM, Demonstrations, save_demos
+    from latentrl.datasets import arm_postures
+
+    postures = arm_postures(40, np.random.default_rng(0))
+    save_demos(Demonstrations(postures, ("a", "b", "c", "d")), tmp_path / "demos.csv")
+    result = latentrl("fit", str(tmp_path / "demos.csv"), "--n-components", "auto", "--max-iter", "30",
+                      "--out", str(tmp_path / "model.npz"))
+    assert result.returncode == 0, result.stderr
+    summary = json.loads(result.stdout)
+    expected = GPLVM(n_components="auto", max_iter=30, random_state=0).fit(postures)
+    assert summary["fitted_n_components"] == expected.n_components_ == GPLVM.load(tmp_path / "model.npz").n_components_
+    assert summary["relevance"] == expected.relevance_.tolist()
+    bad = latentrl("fit", str(tmp_path / "demos.csv"), "--n-components", "two", "--out", str(tmp_path / "m.npz"))
+    assert bad.returncode == 2 and "expected an integer or auto, got 'two'" in bad.stderr
+    pca = latentrl("fit", str(tmp_path / "demos.csv"), "--model", "pca", "--n-components", "auto",
+                   "--out", str(tmp_path / "m.npz"))
+    assert pca.returncode == 1 and "only --model gplvm chooses its dimension" in pca.stderr
+    assert not (tmp_path / "m.npz").exists()
+
+
 def test_fit_reports_bad_demonstration_files(tmp_path):
     result = latentrl("fit", str(tmp_path / "missing.csv"), "--out", str(tmp_path / "m.npz"))
     assert result.returncode == 1 and "missing.csv" in result.stderr

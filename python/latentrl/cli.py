@@ -163,7 +163,8 @@ def build_parser() -> argparse.ArgumentParser:
     fit = sub.add_parser("fit", help="fit a PCA or GPLVM to a demonstration file and save it (NPZ)")
     fit.add_argument("demos", type=Path, help="demonstrated postures: .csv (header of joint names), .npz or .json")
     fit.add_argument("--model", choices=("gplvm", "pca"), default="gplvm", help="the model (default: gplvm)")
-    fit.add_argument("--n-components", type=int, default=2, help="latent dimension d (default: 2)")
+    fit.add_argument("--n-components", type=_dimension, default=2,
+                     help="latent dimension d, or auto (GPLVM: chosen by ARD relevance, docs/encoders.md; default: 2)")
     fit.add_argument("--seed", type=int, default=0, help="random_state of the GPLVM (default: 0)")
     fit.add_argument("--max-iter", type=int, default=1000, help="L-BFGS iteration cap of the GPLVM (default: 1000)")
     fit.add_argument("--out", type=Path, required=True, help="the model file to write (.npz; load with GPLVM.load)")
@@ -197,6 +198,16 @@ def build_parser() -> argparse.ArgumentParser:
     urdf.add_argument("urdf", type=Path, help="the robot's URDF file")
     urdf.add_argument("--json", action="store_true", help="print it as JSON instead of a table")
     return parser
+
+
+def _dimension(text: str) -> int | str:
+    """`--n-components`: an integer, or "auto"."""
+    if text == "auto":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer or auto, got {text!r}") from None
 
 
 def _overrides(args: argparse.Namespace, preset_cls: type) -> dict[str, Any]:
@@ -297,7 +308,10 @@ def _fit(args: argparse.Namespace) -> int:
 
     if args.out.suffix != ".npz":
         raise ValueError(f"--out {args.out}: a model is saved as NPZ; give a file name ending in .npz")
-    demos = load_demos(args.demos, min_postures=args.n_components + 1)
+    auto = args.n_components == "auto"
+    if auto and args.model == "pca":
+        raise ValueError("--n-components auto: only --model gplvm chooses its dimension; give PCA an integer")
+    demos = load_demos(args.demos, min_postures=3 if auto else args.n_components + 1)
     if args.model == "pca":
         model: Any = PCA(n_components=args.n_components)
     else:
@@ -307,7 +321,8 @@ def _fit(args: argparse.Namespace) -> int:
     summary = {"model": type(model).__name__, "file": str(args.out), "postures": len(demos.postures),
                "joint_names": list(demos.joint_names), **model.get_params()}
     if args.model == "gplvm":
-        summary.update(nll=model.nll_, converged=model.converged_, n_iter=model.n_iter_, theta=model.theta_.tolist())
+        summary.update(nll=model.nll_, converged=model.converged_, n_iter=model.n_iter_, theta=model.theta_.tolist(),
+                       fitted_n_components=model.n_components_, relevance=model.relevance_.tolist())
     print(json.dumps(summary, indent=2))
     return 0
 

@@ -40,9 +40,9 @@ class GPLVM(Estimator):
         variance over θ2); d is the number of axes whose relevance is at least
         `relevance_threshold` of the largest, and the model is then fitted with that d
         (`relevance_` keeps the evidence; docs/encoders.md).
-    max_components : int, default=5
-        With n_components="auto": the dimension of the first fit (less than the number of
-        joints and of postures).
+    max_components : int or None, default=None
+        With n_components="auto": the dimension of the first fit, less than the number of
+        joints and of postures (None: 5, or one less than the fewer of the two).
     relevance_threshold : float, default=0.1
         With n_components="auto": the least relative relevance of a kept latent axis.
     max_iter : int, default=1000
@@ -162,7 +162,7 @@ class GPLVM(Estimator):
         random_state: int | None = None,
         encoder: str = "gp",
         tol: float = 1e-6,
-        max_components: int = 5,
+        max_components: int | None = None,
         relevance_threshold: float = 0.1,
     ) -> None:
         self.n_components = n_components
@@ -247,7 +247,7 @@ class GPLVM(Estimator):
         n, joints = X.shape
         if n < 3:
             raise ValueError(f"n_components='auto' needs at least 3 postures to compare latent axes, got {n}")
-        k = int_at_least("max_components", self.max_components, 1)
+        k = min(5, joints - 1, n - 1) if self.max_components is None else int_at_least("max_components", self.max_components, 1)
         if k >= joints or k >= n:
             raise ValueError(f"max_components must be less than the number of joints ({joints}) and of postures "
                              f"({n}), got {k}")
