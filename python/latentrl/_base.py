@@ -4,6 +4,7 @@ likelihood (used by the GPLVM and the GP encoder)."""
 
 from __future__ import annotations
 
+import contextlib
 import inspect
 import json
 import os
@@ -11,7 +12,7 @@ import uuid
 import warnings
 import zipfile
 import zlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, ClassVar, Self
@@ -54,6 +55,20 @@ def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+@contextlib.contextmanager
+def atomic_path(path: PathLike) -> Iterator[Path]:
+    """A temporary file name beside `path` that keeps its suffix (for writers that take a name
+    and choose the format by it: imageio, rerun), renamed over `path` when the block ends and
+    removed if it raises, so such a writer never leaves a half-written `path`."""
+    path = Path(path)
+    tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex}.tmp{path.suffix}")
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 MAX_NPZ_BYTES = 2**30

@@ -349,6 +349,6 @@ def latent_relevance(Z: NDArray[np.float64], theta: NDArray[np.float64]) -> NDAr
     first: each axis's variance over θ2, the inverse squared length scale an ARD kernel on
     unit-variance axes would have (the SE kernel is isotropic, so only the spread of Z along
     an axis tells how much the fit uses it)."""
-    spread = np.linalg.eigvalsh(np.atleast_2d(np.cov(Z.T))) if Z.shape[1] > 1 else np.array([np.var(Z, ddof=1)])
+    spread = np.linalg.eigvalsh(np.atleast_2d(np.cov(Z, rowvar=False)))
     relevance: NDArray[np.float64] = np.sort(np.maximum(spread, 0.0))[::-1] / theta[1]
     return relevance

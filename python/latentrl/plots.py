@@ -87,6 +87,25 @@ def variance_shade(variance: NDArray[np.float64]) -> NDArray[np.float64]:
     return shade
 
 
+def latent_value_grid(
+    weights: NDArray[np.float64],
+    low: NDArray[np.float64],
+    high: NDArray[np.float64],
+    model: Any,
+    *,
+    learner: Mapping[str, Any],
+    grid: int,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The learner's V of `weights` on a `grid` × `grid` mesh over the latent box [low, high]
+    (rows from low z2 to high): the mesh (g0, g1), V on it, and the decoded postures (grid²,
+    D) and GPLVM variances (grid²,) of its points, row by row."""
+    g0, g1 = np.meshgrid(np.linspace(low[0], high[0], grid), np.linspace(low[1], high[1], grid))
+    points = np.column_stack([g0.ravel(), g1.ravel()])
+    postures, variance = model.decoder_.predict(points)
+    value = _native.learner_values(dict(learner), list(low), list(high), np.asarray(weights, dtype=np.float64), points)
+    return g0, g1, value.reshape(g0.shape), postures, variance
+
+
 def latent_value_panel(
     ax: Axes,
     weights: NDArray[np.float64],
@@ -101,12 +120,8 @@ def latent_value_panel(
     """V over the 2-D latent box [low, high] (the learner's own V of `weights`, native), the GPLVM
     variance of `model.decoder_` shaded (darker = higher, log scale), the experiment's `regions`
     and the demonstrations' latent points `model.Z_` (white dots) (paper Fig. 6b/d, 7b/c)."""
-    g0, g1 = np.meshgrid(np.linspace(low[0], high[0], grid), np.linspace(low[1], high[1], grid))
-    points = np.column_stack([g0.ravel(), g1.ravel()])
-    postures, variance = model.decoder_.predict(points)
+    g0, g1, value, postures, variance = latent_value_grid(weights, low, high, model, learner=learner, grid=grid)
     shape = g0.shape
-    value = _native.learner_values(dict(learner), list(low), list(high), np.asarray(weights, dtype=np.float64), points)
-    value = value.reshape(shape)
     extent = (low[0], high[0], low[1], high[1])
     image = ax.imshow(value, origin="lower", extent=extent, aspect="auto", cmap="viridis")
     ax.figure.colorbar(image, ax=ax, label="V")

@@ -6,7 +6,6 @@ path. GIF with Pillow, MP4 with the ffmpeg that imageio-ffmpeg ships: the `[vide
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 from importlib import import_module
 from pathlib import Path
@@ -14,6 +13,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from latentrl._base import atomic_path
 
 #: What `replay` writes, by suffix.
 FORMATS = (".gif", ".mp4")
@@ -172,15 +173,11 @@ def write_video(frames: NDArray[np.uint8], out: Path, fps: int) -> None:
     interrupted write leaves nothing half-written."""
     import imageio.v3 as iio
 
-    temp = out.with_name(f".{out.stem}.{os.getpid()}.tmp{out.suffix}")
-    try:
+    with atomic_path(out) as temp:
         if out.suffix.lower() == ".gif":
             iio.imwrite(temp, frames, duration=1000 / fps, loop=0)
         else:
             iio.imwrite(temp, frames, fps=fps)
-        temp.replace(out)
-    finally:
-        temp.unlink(missing_ok=True)
 
 
 def run_setup(experiment: str, preset: Any) -> tuple[Any, Any, tuple[NDArray[np.float64], NDArray[np.float64]]]:

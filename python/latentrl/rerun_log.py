@@ -7,12 +7,13 @@ latent path on it. Exp 1's toy is drawn in its plane (z = 0)."""
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from latentrl._base import atomic_path
 
 #: Pixels per side of the value map image.
 VALUE_PIXELS = 200
@@ -33,19 +34,14 @@ def value_image(episode: Any) -> NDArray[np.uint8]:
     where the GPLVM variance is high (log scale), the shading of `plots.latent_value_panel`."""
     from matplotlib import colormaps
 
-    from latentrl import _native
-    from latentrl.plots import variance_shade
+    from latentrl.plots import latent_value_grid, variance_shade
 
-    g0, g1 = np.meshgrid(np.linspace(episode.low[0], episode.high[0], VALUE_PIXELS),
-                         np.linspace(episode.high[1], episode.low[1], VALUE_PIXELS))
-    points = np.column_stack([g0.ravel(), g1.ravel()])
-    value = _native.learner_values(dict(episode.learner), list(episode.low), list(episode.high),
-                                   np.asarray(episode.weights, dtype=np.float64), points).reshape(g0.shape)
-    _, variance = episode.model.decoder_.predict(points)
+    g0, _, value, _, variance = latent_value_grid(episode.weights, episode.low, episode.high, episode.model,
+                                                  learner=episode.learner, grid=VALUE_PIXELS)
     span = max(float(np.ptp(value)), 1e-12)
     rgb: NDArray[np.float64] = colormaps["viridis"]((value - value.min()) / span)[..., :3]
     rgb *= 1 - 0.6 * variance_shade(variance).reshape(g0.shape)[..., None]
-    return (255 * rgb).round().astype(np.uint8)
+    return (255 * np.flipud(rgb)).round().astype(np.uint8)  # image rows run from high z2 down
 
 
 def to_pixels(episode: Any, z: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -126,9 +122,8 @@ def write_rerun(episode: Any, out: Path) -> None:
     temporary file, so a failed or interrupted write leaves nothing half-written."""
     import rerun as rr
 
-    temp = out.with_name(f".{out.stem}.{os.getpid()}.tmp{out.suffix}")
     rec = rr.RecordingStream("latentrl")
-    try:
+    with atomic_path(out) as temp:
         rec.save(temp)
         _log_static(rec, episode)
         latent = to_pixels(episode, episode.latent)
@@ -144,6 +139,3 @@ def write_rerun(episode: Any, out: Path) -> None:
             rec.log("latent/point", rr.Points2D(latent[step : step + 1], colors=[255, 0, 0], radii=3))
         rec.flush()
         rec.disconnect()
-        temp.replace(out)
-    finally:
-        temp.unlink(missing_ok=True)
