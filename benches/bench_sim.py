@@ -102,8 +102,10 @@ class RapierRobot:
         pgs_iterations: int = 1,
         floor: float | None = None,
         sole: str | None = None,
+        dt: float = DT,
+        substeps: int = SUBSTEPS,
     ) -> None:
-        physics = {"dt": DT, "substeps": SUBSTEPS, "solver_iterations": iterations, "pgs_iterations": pgs_iterations}
+        physics = {"dt": dt, "substeps": substeps, "solver_iterations": iterations, "pgs_iterations": pgs_iterations}
         self.sim = Sim(urdf, root="floating" if floating else "fixed", floor=floor, physics=physics, servo=gains)
         self.floor = 0.0 if floor is None else floor
         self.floating = floating
@@ -148,9 +150,10 @@ class MujocoRobot:
         floating_body: str | None = None,
         floor: bool = False,
         start_height: float = 0.0,
+        dt: float = DT,
     ) -> None:
         spec = mujoco.MjSpec.from_file(str(urdf))
-        spec.option.timestep = DT
+        spec.option.timestep = dt
         spec.option.gravity = [0.0, 0.0, -9.81]
         spec.option.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{integrator.upper()}")
         for geom in spec.geoms:  # robot shapes touch the floor only (no self-collisions)

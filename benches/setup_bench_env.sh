@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Creates benches/.venv-bench: the peers GPy, MuJoCo and Pinocchio (never runtime dependencies of
-# latentrl) and a release wheel of latentrl built from this tree, in a venv of their own so the
-# peers' pins cannot touch the project's .venv. Idempotent; re-run after changing Rust code to
-# refresh the wheel.
+# latentrl), matplotlib (bench_accuracy.py's figures) and a release wheel of latentrl built from
+# this tree, in a venv of their own so the peers' pins cannot touch the project's .venv.
+# Idempotent; re-run after changing Rust code to refresh the wheel.
 #
 #   bash benches/setup_bench_env.sh && benches/.venv-bench/bin/python benches/bench_gp.py
 #   benches/.venv-bench/bin/python benches/bench_sim.py
@@ -17,7 +17,7 @@ if [ ! -x "$VENV/bin/python" ]; then
     "$PYTHON" -m venv "$VENV"
     "$VENV/bin/python" -m pip install --quiet --upgrade pip
 fi
-"$VENV/bin/python" -m pip install --quiet "GPy>=1.13" "mujoco>=3.13" "pin>=3" threadpoolctl
+"$VENV/bin/python" -m pip install --quiet "GPy>=1.13" "mujoco>=3.13" "pin>=3" threadpoolctl "matplotlib>=3.8"
 
 if [ ! -x "$MATURIN" ]; then
     echo "setup_bench_env: $MATURIN not found; run 'make build' first or set MATURIN" >&2
