@@ -1,6 +1,6 @@
 """A recorded episode as a Rerun recording (`latentrl replay --rerun FILE.rrd`, the `[viewer]`
 extra; view it with `rerun FILE.rrd`): on the timeline `step`, the robot's collision shapes as
-3-D solids (boxes, spheres, cylinders, capsules; a mesh link as its origin point), the
+3-D solids (boxes, spheres, cylinders, capsules; a mesh link only by its sticks), the
 kinematic tree, the effectors' paths so far, the obstacles, floor and target; and beside it the
 learnt V over the latent box (GPLVM variance shaded, as in the figures) as an image with the
 latent path on it. Exp 1's toy is drawn in its plane (z = 0)."""
