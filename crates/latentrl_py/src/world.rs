@@ -106,7 +106,7 @@ impl PySim {
                 self.inner.config().floor.ok_or_else(|| {
                     InvalidInputError::new_err("reset_on_ground: this Sim has no floor (pass floor=...)")
                 })?;
-            reset_on_ground(&mut self.inner, &vector(&posture), sole, ground, clearance).map_err(sim_to_py)
+            reset_on_ground(&mut self.inner, &vector(&posture), sole, ground, clearance, None).map_err(sim_to_py)
         })
     }
 

@@ -60,8 +60,9 @@ fn physics_steps(c: &mut Criterion) {
     ];
     for (label, posture, iterations) in settings {
         let mut sim = humanoid(iterations);
-        let start =
-            |sim: &mut World| reset_on_ground(sim, posture, "l_foot", 0.0, 5e-4).expect("start posture within limits");
+        let start = |sim: &mut World| {
+            reset_on_ground(sim, posture, "l_foot", 0.0, 5e-4, None).expect("start posture within limits")
+        };
         start(&mut sim);
         group.bench_function(BenchmarkId::from_parameter(label), |b| {
             b.iter(|| {

@@ -209,15 +209,25 @@ pub fn support_margin(sim: &World, soles: &[String]) -> Result<f64> {
 }
 
 /// Resets the robot to `posture` with the first sole flat on the ground: the base is
-/// placed so that this sole's frame keeps its x–y position and heading at the identity
-/// base, with no roll or pitch, and its lowest box corner `clearance` (m) above `ground`.
-pub fn reset_on_ground(sim: &mut World, posture: &[f64], sole: &str, ground: f64, clearance: f64) -> Result<()> {
+/// placed so that this sole's frame stands at `stance` (x, y), or keeps the x–y position it
+/// has at the identity base if `stance` is `None`, with the heading it has there, no roll or
+/// pitch, and its lowest box corner `clearance` (m) above `ground`.
+pub fn reset_on_ground(
+    sim: &mut World,
+    posture: &[f64],
+    sole: &str,
+    ground: f64,
+    clearance: f64,
+    stance: Option<[f64; 2]>,
+) -> Result<()> {
     check_finite("ground height and clearance", &[ground, clearance])?;
     sim.reset_with_base(posture, &Isometry3::identity())?;
     let sole_pose = sim.link_pose(sole)?;
     let (_, _, yaw) = sole_pose.rotation.euler_angles();
+    let [x, y] = stance.unwrap_or([sole_pose.translation.x, sole_pose.translation.y]);
+    check_finite("stance", &[x, y])?;
     let flat = Isometry3::from_parts(
-        Translation3::new(sole_pose.translation.x, sole_pose.translation.y, 0.0),
+        Translation3::new(x, y, 0.0),
         UnitQuaternion::from_euler_angles(0.0, 0.0, yaw),
     );
     let base = flat * sole_pose.inverse();

@@ -117,7 +117,7 @@ pub fn run_fall_check_observed(
         }));
     }
     let ground = sim.config.floor.unwrap_or(0.0);
-    reset_on_ground(sim, start, &config.soles[0], ground, 5e-4)?;
+    reset_on_ground(sim, start, &config.soles[0], ground, 5e-4, None)?;
     let mut fall = config.fall.clone();
     if fall.min_base_height <= 0.0 {
         fall.min_base_height = ground + 0.5 * (sim.base_pose().translation.z - ground);

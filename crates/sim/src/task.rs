@@ -92,6 +92,9 @@ impl Task {
                 link(format!("constraints[{i}].link"), l)?;
             }
         }
+        if let Some(l) = &config.target.relative_to {
+            link("target.relative_to".to_string(), l)?;
+        }
         for (i, pair) in config.physics.ignore_collisions.iter().enumerate() {
             for (j, l) in pair.iter().enumerate() {
                 link(format!("physics.ignore_collisions[{i}][{j}]"), l)?;

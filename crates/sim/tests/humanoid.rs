@@ -47,7 +47,7 @@ fn model_has_the_documented_size_and_mass() {
     let mut sim = humanoid(sim_options());
     assert_eq!(sim.num_joints(), 19);
     let home = vec![0.0; 19];
-    reset_on_ground(&mut sim, &home, "l_foot", 0.0, 0.0).unwrap();
+    reset_on_ground(&mut sim, &home, "l_foot", 0.0, 0.0, None).unwrap();
     let head = sim.link_pose("head").unwrap().translation.z + 0.06;
     assert!((0.339..=0.40).contains(&head), "height {head}");
     let l = sim.link_pose("l_foot").unwrap().translation;
@@ -60,7 +60,7 @@ fn every_demo_pose_holds_for_two_seconds() {
         for (i, pose) in demos(file).iter().enumerate() {
             let mut sim = humanoid(sim_options());
             let config = FallCheckConfig::for_task(&common::task("humanoid_lift"), 2.0).unwrap();
-            reset_on_ground(&mut sim, pose, "l_foot", 0.0, 0.0).unwrap();
+            reset_on_ground(&mut sim, pose, "l_foot", 0.0, 0.0, None).unwrap();
             let kinematic = support_margin(&sim, &config.soles).unwrap();
             let r = &run_fall_check(&mut sim, pose, std::slice::from_ref(pose), &config).unwrap()[0];
             eprintln!(
@@ -83,7 +83,7 @@ fn stands_for_ten_seconds_at_home_posture() {
         let physics = (options.physics.solver_iterations, options.physics.pgs_iterations);
         let mut sim = humanoid(options.clone());
         let home = vec![0.0; 19];
-        reset_on_ground(&mut sim, &home, "l_foot", 0.0, 5e-4).unwrap();
+        reset_on_ground(&mut sim, &home, "l_foot", 0.0, 5e-4, None).unwrap();
         let start = sim.base_pose().translation;
         let config = FallCheckConfig::for_task(&common::task("humanoid_lift"), 10.0).unwrap();
         let report = run_fall_check(&mut sim, &home, std::slice::from_ref(&home), &config).unwrap();

@@ -102,6 +102,9 @@ params! {
         theta: f64 = 0.35 => Rule::Positive,
         /// "Reached the target": RMS per-effector distance to h* at most this (m).
         reach_radius: f64 = 0.05 => Rule::Positive,
+        /// A link from whose origin h and h* are measured (world axes), e.g. the standing sole:
+        /// the target moves with the feet. Absent: world positions.
+        relative_to: Option<String> = None => Rule::NonEmpty,
     }
 }
 
@@ -304,6 +307,9 @@ params! {
         /// A start is refused unless the centre of mass lies at least this far (m) inside the
         /// support polygon (negative: outside allowed).
         min_start_margin: f64 = 0.0 => Rule::closed(-1.0, 1.0),
+        /// Where the first sole stands at every reset, [x, y] on the floor (m); absent: where
+        /// the posture puts it with the base over the origin, so the feet move with the posture.
+        stance: Option<[f64; 2]> = None => Rule::closed(-1000.0, 1000.0),
     }
 }
 

@@ -52,6 +52,8 @@ pub struct TaskPlant {
     task: Arc<Task>,
     world: World,
     effector_frames: Vec<Frame>,
+    /// The frame h and h* are measured from (`target.relative_to`), if any.
+    target_origin: Option<Frame>,
     constraints: Vec<Constraint>,
     /// Effector-tested boxes: lower and upper corners.
     point_boxes: Vec<([f64; 3], [f64; 3])>,
@@ -120,6 +122,12 @@ impl TaskPlant {
             .iter()
             .map(|e| world.frame(e, [0.0; 3]))
             .collect::<Result<Vec<_>>>()?;
+        let target_origin = config
+            .target
+            .relative_to
+            .as_ref()
+            .map(|l| world.frame(l, [0.0; 3]))
+            .transpose()?;
         let constraints = config
             .constraints
             .iter()
@@ -157,6 +165,7 @@ impl TaskPlant {
         let mut plant = Self {
             world,
             effector_frames,
+            target_origin,
             constraints,
             point_boxes,
             target: config.target.position.iter().flatten().copied().collect(),
@@ -199,7 +208,15 @@ impl TaskPlant {
         }
         match (&mut self.fall, self.task.config().floor.as_ref()) {
             (Some(fall), Some(floor)) => {
-                reset_on_ground(&mut self.world, posture, &fall.soles[0], floor.height, CLEARANCE)?;
+                let stance = self.task.config().fall.as_ref().and_then(|f| f.stance);
+                reset_on_ground(
+                    &mut self.world,
+                    posture,
+                    &fall.soles[0],
+                    floor.height,
+                    CLEARANCE,
+                    stance,
+                )?;
                 let base = self.world.base_pose().translation.z;
                 let fraction = self.task.config().fall.as_ref().map_or(0.5, |f| f.base_height_fraction);
                 fall.min_base_height = floor.height + fraction * (base - floor.height);
@@ -236,11 +253,17 @@ impl TaskPlant {
         }
     }
 
+    /// ‖h − h*‖², h measured from `target.relative_to`'s origin if set.
     fn squared_distance(&self) -> f64 {
+        let origin = self
+            .target_origin
+            .as_ref()
+            .map_or([0.0; 3], |f| self.world.frame_position(f));
         self.effectors
-            .iter()
-            .zip(&self.target)
-            .map(|(a, b)| (a - b) * (a - b))
+            .chunks_exact(3)
+            .zip(self.target.chunks_exact(3))
+            .flat_map(|(h, t)| (0..3).map(move |k| h[k] - origin[k] - t[k]))
+            .map(|e| e * e)
             .sum()
     }
 
