@@ -1,8 +1,55 @@
 //! The learner's state space relative to the plant's posture space: the postures
-//! themselves, or a latent space with a GP decoder and encoder (paper Sec. III-B/E).
+//! themselves, or a latent space with a GP decoder and an encoder (paper Sec. III-B/E).
 
 use crate::error::{CoreError, Result};
 use crate::gp::{GpMap, PredictScratch};
+use crate::projection::ProjectionScratch;
+
+/// A posture → latent map the RL loop encodes with (step 6 of SPEC §3.1): a [`GpMap`] (the
+/// out-of-sample GP or the back-constraint: its mean) or a [`crate::Projection`].
+pub trait Encode: std::fmt::Debug + Send + Sync {
+    /// Posture dimension D.
+    fn input_dim(&self) -> usize;
+    /// Latent dimension d.
+    fn output_dim(&self) -> usize;
+    /// Fresh buffers for [`Encode::encode_into`].
+    fn encode_scratch(&self) -> EncodeScratch;
+    /// Encodes `posture` (length D) into `z` (length d), allocation-free with buffers of this
+    /// map (others are replaced once); lengths and finiteness are the caller's contract.
+    fn encode_into(&self, posture: &[f64], z: &mut [f64], scratch: &mut EncodeScratch);
+}
+
+/// Buffers of an [`Encode`] map.
+#[derive(Debug, Clone)]
+pub enum EncodeScratch {
+    /// Of a [`GpMap`].
+    Map(PredictScratch),
+    /// Of a [`crate::Projection`].
+    Projection(Box<ProjectionScratch>),
+}
+
+impl Encode for GpMap {
+    fn input_dim(&self) -> usize {
+        self.inputs.nrows()
+    }
+
+    fn output_dim(&self) -> usize {
+        self.alpha_t.nrows()
+    }
+
+    fn encode_scratch(&self) -> EncodeScratch {
+        EncodeScratch::Map(self.scratch())
+    }
+
+    fn encode_into(&self, posture: &[f64], z: &mut [f64], scratch: &mut EncodeScratch) {
+        if !matches!(scratch, EncodeScratch::Map(_)) {
+            *scratch = self.encode_scratch();
+        }
+        if let EncodeScratch::Map(s) = scratch {
+            self.mean_into(posture, z, s);
+        }
+    }
+}
 
 /// The learner's state space relative to the plant's posture space.
 #[derive(Debug, Clone, Copy)]
@@ -10,12 +57,12 @@ pub enum StateSpace<'a> {
     /// The posture space itself: decode and encode are the identity.
     Full,
     /// A latent space: `decoder` maps latent → posture (GPLVM mean, Eq. 4), `encoder`
-    /// posture → latent (out-of-sample GP or back-constraint, Sec. III-B).
+    /// posture → latent (out-of-sample GP, back-constraint or iterative projection, Sec. III-B).
     Latent {
         /// Latent → posture GP map.
         decoder: &'a GpMap,
-        /// Posture → latent GP map.
-        encoder: &'a GpMap,
+        /// Posture → latent map.
+        encoder: &'a dyn Encode,
     },
 }
 
@@ -23,7 +70,7 @@ pub enum StateSpace<'a> {
 #[derive(Debug, Clone)]
 pub struct SpaceScratch {
     decode: Option<PredictScratch>,
-    encode: Option<PredictScratch>,
+    encode: Option<EncodeScratch>,
 }
 
 impl<'a> StateSpace<'a> {
@@ -72,7 +119,7 @@ impl<'a> StateSpace<'a> {
             },
             StateSpace::Latent { decoder, encoder } => SpaceScratch {
                 decode: Some(decoder.scratch()),
-                encode: Some(encoder.scratch()),
+                encode: Some(encoder.encode_scratch()),
             },
         }
     }
@@ -98,7 +145,7 @@ impl<'a> StateSpace<'a> {
     #[inline]
     pub fn encode(&self, posture: &[f64], z: &mut [f64], s: &mut SpaceScratch) {
         match (self, s.encode.as_mut()) {
-            (StateSpace::Latent { encoder, .. }, Some(s)) => encoder.mean_into(posture, z, s),
+            (StateSpace::Latent { encoder, .. }, Some(s)) => encoder.encode_into(posture, z, s),
             _ => z.copy_from_slice(posture),
         }
     }

@@ -24,7 +24,7 @@ use crate::error::{CoreError, Result};
 use crate::gp::GpMap;
 use crate::learner::{Learner, Phase};
 use crate::plant::Plant;
-use crate::space::StateSpace;
+use crate::space::{Encode, StateSpace};
 
 /// The generator of trial `trial`: ChaCha8 seeded from `base_seed`, stream `trial`
 /// (2⁶⁴ independent streams per seed).
@@ -177,8 +177,8 @@ where
 pub struct LatentSpace<'a> {
     /// Latent → posture GP map (GPLVM mean, Eq. 4).
     pub decoder: &'a GpMap,
-    /// Posture → latent GP map (out-of-sample GP or back-constraint).
-    pub encoder: &'a GpMap,
+    /// Posture → latent map (out-of-sample GP, back-constraint or iterative projection).
+    pub encoder: &'a dyn Encode,
     /// Lower corner of the latent box.
     pub low: &'a [f64],
     /// Upper corner of the latent box.
