@@ -91,6 +91,26 @@ class GpMap:
         """(θ1, θ2, θ3)."""
 
 @final
+class Projection:
+    """The iterative-projection encoder posture → latent of a GPLVM decoder (docs/encoders.md)."""
+
+    def __new__(
+        cls, decoder: GpMap, postures: NDArray[np.float64], *, max_iter: int = 200, margin: float = 0.5
+    ) -> Projection:
+        """The projection under `decoder` (a GpMap latent → posture) fitted to `postures` (N, D),
+        with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`."""
+    def encode(self, postures: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Latent points (M, d) of `postures` (M, D), in parallel."""
+    def encode_one(self, posture: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The latent point (d,) of one `posture` (D,): the call the Rust RL loop makes each step."""
+    @property
+    def input_dim(self) -> int:
+        """Posture dimension D."""
+    @property
+    def output_dim(self) -> int:
+        """Latent dimension d."""
+
+@final
 class Sim:
     """A URDF robot in a rapier3d world, every actuated joint PD-servoed to its target."""
 
@@ -344,7 +364,7 @@ class LatentPolicy:
         high: Sequence[float],
         weights: NDArray[np.float64],
         decoder: GpMap,
-        encoder: GpMap,
+        encoder: GpMap | Projection,
     ) -> LatentPolicy:
         """The policy of `learner` over [low, high] with `weights`."""
     def act(
@@ -358,7 +378,7 @@ def run_task_trials(
     task: Task,
     *,
     decoder: GpMap,
-    encoder: GpMap,
+    encoder: GpMap | Projection,
     latent_low: ArrayLike,
     latent_high: ArrayLike,
     n_trials: int,
