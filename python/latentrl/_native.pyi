@@ -17,6 +17,7 @@ __all__ = [
     "LatentPolicy",
     "LatentrlError",
     "NumericalError",
+    "Projection",
     "Sim",
     "Task",
     "TaskPlant",
