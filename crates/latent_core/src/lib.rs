@@ -5,6 +5,7 @@
 
 pub mod back_constraint;
 pub mod config;
+pub mod encode;
 pub mod episode;
 pub mod error;
 pub mod gp;
@@ -22,6 +23,7 @@ pub mod td;
 pub mod trials;
 
 pub use config::{ActionSet, LearnerConfig};
+pub use encode::{Encode, EncodeScratch};
 pub use episode::{Bounds, EpisodeRecord, EpisodeScratch, StepResult, TransitionScratch, refused, transition};
 pub use error::{CoreError, Result};
 pub use gp::{GpMap, PredictScratch};
@@ -33,6 +35,6 @@ pub use plant::{EndReason, Plant, StepOutcome};
 pub use policy::SoftmaxPolicy;
 pub use projection::{Projection, ProjectionConfig, ProjectionScratch};
 pub use rbf::{RbfConfig, RbfGrid, SparseFeatures};
-pub use space::{Encode, EncodeScratch, StateSpace};
+pub use space::StateSpace;
 pub use td::TdLearner;
 pub use trials::{TrialOptions, TrialResult, run_trials, trial_rng};

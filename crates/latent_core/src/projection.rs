@@ -16,7 +16,6 @@ use rayon::prelude::*;
 use crate::error::{CoreError, Result, check_finite};
 use crate::gp::GpMap;
 use crate::lbfgs::{LbfgsScratch, minimise};
-use crate::space::{Encode, EncodeScratch};
 
 /// Settings of a [`Projection`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -114,6 +113,16 @@ impl Projection {
             high,
             max_iter: config.max_iter,
         })
+    }
+
+    /// Posture dimension D (the decoder's output).
+    pub fn posture_dim(&self) -> usize {
+        self.decoder.output_dim()
+    }
+
+    /// Latent dimension d (the decoder's input).
+    pub fn latent_dim(&self) -> usize {
+        self.decoder.input_dim()
     }
 
     /// The search box's lower and upper corners (d each).
@@ -269,29 +278,6 @@ impl Projection {
         map.lower.tr_solve_lower_triangular_mut(&mut s.solved);
         s.d_variance.gemv_tr(-2.0, &s.dk, &s.solved, 0.0);
         variance
-    }
-}
-
-impl Encode for Projection {
-    fn input_dim(&self) -> usize {
-        self.decoder.output_dim()
-    }
-
-    fn output_dim(&self) -> usize {
-        self.decoder.input_dim()
-    }
-
-    fn encode_scratch(&self) -> EncodeScratch {
-        EncodeScratch::Projection(Box::new(self.scratch()))
-    }
-
-    fn encode_into(&self, posture: &[f64], z: &mut [f64], scratch: &mut EncodeScratch) {
-        if !matches!(scratch, EncodeScratch::Projection(_)) {
-            *scratch = self.encode_scratch();
-        }
-        if let EncodeScratch::Projection(s) = scratch {
-            Projection::encode_into(self, posture, z, s);
-        }
     }
 }
 

@@ -1,56 +1,9 @@
 //! The learner's state space relative to the plant's posture space: the postures
 //! themselves, or a latent space with a GP decoder and an encoder (paper Sec. III-B/E).
 
+use crate::encode::{Encode, EncodeScratch};
 use crate::error::{CoreError, Result};
 use crate::gp::{GpMap, PredictScratch};
-use crate::projection::ProjectionScratch;
-
-/// A posture → latent map the RL loop encodes with (step 6 of SPEC §3.1): a [`GpMap`] (the
-/// out-of-sample GP or the back-constraint: its mean) or a [`crate::Projection`].
-pub trait Encode: std::fmt::Debug + Send + Sync {
-    /// Posture dimension D.
-    fn input_dim(&self) -> usize;
-    /// Latent dimension d.
-    fn output_dim(&self) -> usize;
-    /// Fresh buffers for [`Encode::encode_into`].
-    fn encode_scratch(&self) -> EncodeScratch;
-    /// Encodes `posture` (length D) into `z` (length d), allocation-free with buffers of this
-    /// map (others are replaced once); lengths and finiteness are the caller's contract.
-    fn encode_into(&self, posture: &[f64], z: &mut [f64], scratch: &mut EncodeScratch);
-}
-
-/// Buffers of an [`Encode`] map.
-#[derive(Debug, Clone)]
-pub enum EncodeScratch {
-    /// Of a [`GpMap`].
-    Map(PredictScratch),
-    /// Of a [`crate::Projection`].
-    Projection(Box<ProjectionScratch>),
-}
-
-impl Encode for GpMap {
-    fn input_dim(&self) -> usize {
-        self.inputs.nrows()
-    }
-
-    fn output_dim(&self) -> usize {
-        self.alpha_t.nrows()
-    }
-
-    fn encode_scratch(&self) -> EncodeScratch {
-        EncodeScratch::Map(self.scratch())
-    }
-
-    fn encode_into(&self, posture: &[f64], z: &mut [f64], scratch: &mut EncodeScratch) {
-        if !matches!(scratch, EncodeScratch::Map(_)) {
-            *scratch = self.encode_scratch();
-        }
-        if let EncodeScratch::Map(s) = scratch {
-            self.mean_into(posture, z, s);
-        }
-    }
-}
-
 /// The learner's state space relative to the plant's posture space.
 #[derive(Debug, Clone, Copy)]
 pub enum StateSpace<'a> {

@@ -19,12 +19,13 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+use crate::encode::Encode;
 use crate::episode::{EpisodeRecord, EpisodeScratch};
 use crate::error::{CoreError, Result};
 use crate::gp::GpMap;
 use crate::learner::{Learner, Phase};
 use crate::plant::Plant;
-use crate::space::{Encode, StateSpace};
+use crate::space::StateSpace;
 
 /// The generator of trial `trial`: ChaCha8 seeded from `base_seed`, stream `trial`
 /// (2⁶⁴ independent streams per seed).

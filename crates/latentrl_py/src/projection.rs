@@ -62,7 +62,7 @@ impl PyProjection {
         guard(|| {
             let x = posture.as_array().to_vec();
             self.inner.check_posture(&x).map_err(to_py)?;
-            let mut z = vec![0.0; Encode::output_dim(&self.inner)];
+            let mut z = vec![0.0; self.inner.latent_dim()];
             self.inner.encode_into(&x, &mut z, &mut self.inner.scratch());
             Ok(PyArray1::from_vec(py, z))
         })
@@ -71,13 +71,13 @@ impl PyProjection {
     /// Posture dimension D.
     #[getter]
     fn input_dim(&self) -> PyResult<usize> {
-        guard(|| Ok(Encode::input_dim(&self.inner)))
+        guard(|| Ok(self.inner.posture_dim()))
     }
 
     /// Latent dimension d.
     #[getter]
     fn output_dim(&self) -> PyResult<usize> {
-        guard(|| Ok(Encode::output_dim(&self.inner)))
+        guard(|| Ok(self.inner.latent_dim()))
     }
 }
 
