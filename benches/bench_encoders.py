@@ -15,14 +15,20 @@ is its own fit (Z_ = K_b W). Every fit: d = 2, the GPLVM defaults, random_state 
 - held out: ‖decode(encode(x)) − x‖ (rad, RMS over joints) of postures left out of the fit:
   5 folds for the arm sets, leave-one-out for the 7 humanoid demos; mean.
 - encode µs: one posture per call from Python (`transform`), and the native map alone
-  (`encoder_.predict_one`, what the Rust RL loop calls per step); median of 2000 calls.
+  (`encoder_.predict_one`, or `native_projection_.encode_one` for "projection": what the Rust
+  RL loop calls per step); median of 2000 calls.
 - fit s: wall time of `GPLVM.fit`.
+- projection only, native vs SciPy: the largest ‖native − SciPy‖ over the grid's decoded
+  postures and the demos, ÷ latent span (JSON only).
+
+The table between the markers of docs/encoders.md is rewritten from the results.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import re
 import statistics
 import time
 from pathlib import Path
@@ -79,11 +85,10 @@ def encode_cost(model: GPLVM, X: np.ndarray, encoder: str, calls: int) -> tuple[
         t = time.perf_counter()
         model.transform(x, method=encoder)
         python.append(time.perf_counter() - t)
-    if encoder == "projection":
-        return statistics.median(python) * 1e6, float("nan")
+    encode_one = model.native_projection_.encode_one if encoder == "projection" else model.encoder_.predict_one
     for _ in range(calls):
         t = time.perf_counter()
-        model.encoder_.predict_one(x[0])
+        encode_one(x[0])
         native.append(time.perf_counter() - t)
     return statistics.median(python) * 1e6, statistics.median(native) * 1e6
 
@@ -97,10 +102,41 @@ def row(X: np.ndarray, encoder: str, calls: int) -> dict[str, float]:
     trip = np.linalg.norm(model.transform(model.inverse_transform(z), method=encoder) - z, axis=1)
     demo = np.linalg.norm(model.transform(X, method=encoder) - model.Z_, axis=1)
     python_us, native_us = encode_cost(model, X, encoder, calls)
-    return {"fit_s": fit_s, "encode_decode_mean": float(trip.mean()), "encode_decode_max": float(trip.max()),
+    span = float(np.ptp(model.Z_, axis=0).max())
+    extra = {}
+    if encoder == "projection":
+        postures = np.vstack([model.inverse_transform(z), X])
+        gap = np.linalg.norm(model.native_projection_.encode(postures) - model.transform(postures, method=encoder), axis=1)
+        extra = {"native_vs_scipy_max": float(gap.max()) / span}
+    return {**extra, "fit_s": fit_s, "encode_decode_mean": float(trip.mean()), "encode_decode_max": float(trip.max()),
             "demos_max": float(demo.max()), "held_out_rms_rad": held_out(X, encoder),
             "encode_us_python": python_us, "encode_us_native": native_us,
-            "latent_span": float(np.ptp(model.Z_, axis=0).max())}
+            "latent_span": span}
+
+
+def microseconds(value: float) -> str:
+    """A time in µs as the table shows it."""
+    return f"{value:.0f}" if value >= 100 else f"{value:.1f}"
+
+
+def table(sets: dict[str, dict[str, dict[str, float]]]) -> str:
+    """The markdown table of docs/encoders.md."""
+    lines = ["| set | encoder | fit (s) | encode∘decode over the box, mean / max (÷ latent span) | demos: max ‖encode(x) − z‖ "
+             "| held out: decode∘encode RMS (rad) | encode µs: Python / native |", "|---|---|---|---|---|---|---|"]
+    for name, rows in sets.items():
+        for enc, r in rows.items():
+            span = r["latent_span"]
+            lines.append(f"| {name} | {enc} | {r['fit_s']:.2f} | {r['encode_decode_mean'] / span:.4f} / "
+                         f"{r['encode_decode_max'] / span:.3f} | {r['demos_max']:.1e} | {r['held_out_rms_rad']:.4f} | "
+                         f"{microseconds(r['encode_us_python'])} / {microseconds(r['encode_us_native'])} |")
+    return "\n".join(lines)
+
+
+def write_table(sets: dict[str, dict[str, dict[str, float]]], doc: Path) -> None:
+    """Replaces the table between the `encoders` markers of `doc`."""
+    text = doc.read_text()
+    body = f"<!-- encoders:begin -->\n{table(sets)}\n<!-- encoders:end -->"
+    doc.write_text(re.sub(r"<!-- encoders:begin -->.*<!-- encoders:end -->", lambda _: body, text, flags=re.S))
 
 
 def main() -> None:
@@ -114,6 +150,7 @@ def main() -> None:
         for enc, r in rows.items():
             print(name, enc, json.dumps({k: round(v, 6) for k, v in r.items()}))
     args.out.write_text(json.dumps({"sets": out, "threads": "default"}, indent=2) + "\n")
+    write_table(out, ROOT / "docs" / "encoders.md")
 
 
 if __name__ == "__main__":

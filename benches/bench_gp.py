@@ -18,6 +18,12 @@ variance playing θ3. That is latentrl's "SE + white noise" kernel (paper Eq. 2)
 likelihood noise cannot be switched off, so `RBF + White` in GPy would add a second noise term.
 GPy's exact inference adds a constant 1e-8 to K's diagonal, so its likelihood variance holds
 θ3 − 1e-8, and the white-noise floor (θ3 ≥ 1e-6) is `constrain_bounded(1e-6 − 1e-8, 1e6)` on it.
+
+GPy's back-constrained model: `GPy.models.BCGPLVM(Y − mean, 2, kernel=RBF(2), mapping=Kernel(D,
+2, Z=Y − mean, RBF(D)))`, the mapping's RBF variance fixed at 1 and its lengthscale² playing β:
+the latent points are `K_b A`, our `K_b W`. Both start from our start: W₀ the ridge solve of the
+PCA start, β₀ the median squared distance between postures, θ₀ with θ3 at least the floor, and
+the same noise floor as the plain GPLVM.
 """
 
 from __future__ import annotations
@@ -35,11 +41,15 @@ from typing import Any
 import numpy as np
 from scipy.linalg import cho_factor, solve_triangular
 from scipy.optimize import fmin_l_bfgs_b
+from scipy.spatial.distance import pdist
 
 import latentrl
+import latentrl._base
+import latentrl.gplvm
 from latentrl import GPLVM
 from latentrl._base import initial_log_theta
-from latentrl._native import GpMap, gplvm_nll_grad
+from latentrl._native import GpMap, gplvm_back_constrained_nll_grad, gplvm_nll_grad
+from latentrl.back_constraint import start_weights
 from latentrl._reference import gplvm_nll_grad as numpy_nll_grad
 from latentrl._reference import se_kernel
 from latentrl.datasets import arm_postures
@@ -151,7 +161,11 @@ class NumpyGp:
 def gpy_gplvm(centred: np.ndarray, latent: np.ndarray, theta: np.ndarray) -> Any:
     """GPy's GPLVM with latentrl's kernel and parameters (see the module docstring)."""
     kernel = GPy.kern.RBF(latent.shape[1], variance=theta[0], lengthscale=np.sqrt(theta[1]))
-    model = GPy.models.GPLVM(centred, latent.shape[1], X=latent.copy(), kernel=kernel)
+    return floored(GPy.models.GPLVM(centred, latent.shape[1], X=latent.copy(), kernel=kernel), theta)
+
+
+def floored(model: Any, theta: np.ndarray) -> Any:
+    """`model` with its likelihood variance θ3 − GPY_JITTER, bounded below by our noise floor."""
     # The bound sits a hair (1e-6 relative) below the floor: a value exactly on a logistic
     # bound is not representable, and at θ3 = floor K's condition number is ~1e8.
     model.Gaussian_noise.variance.constrain_bounded(
@@ -159,6 +173,17 @@ def gpy_gplvm(centred: np.ndarray, latent: np.ndarray, theta: np.ndarray) -> Any
     )
     model.Gaussian_noise.variance[:] = theta[2] - GPY_JITTER
     return model
+
+
+def gpy_bcgplvm(centred: np.ndarray, weights: np.ndarray, theta: np.ndarray, log_beta: float) -> Any:
+    """GPy's BCGPLVM with latentrl's kernel, back-constraint and parameters (module docstring)."""
+    d = weights.shape[1]
+    back = GPy.kern.RBF(centred.shape[1], variance=1.0, lengthscale=np.exp(0.5 * log_beta))
+    mapping = GPy.mappings.Kernel(centred.shape[1], d, centred.copy(), back)
+    mapping.A[:] = weights
+    mapping.kern.variance.fix(warning=False)
+    kernel = GPy.kern.RBF(d, variance=theta[0], lengthscale=np.sqrt(theta[1]))
+    return floored(GPy.models.BCGPLVM(centred, d, kernel=kernel, mapping=mapping), theta)
 
 
 def gpy_regression(inputs: np.ndarray, centred: np.ndarray, theta: np.ndarray) -> Any:
@@ -216,6 +241,9 @@ def run_case(name: str, X: np.ndarray, *, quick: bool) -> dict[str, Any]:
     rows["decode_one_latentrl_predict_one"] = per_call(lambda: decoder.predict_one(z1))
     rows["decode_one_latentrl_inverse_transform"] = per_call(
         lambda: model.inverse_transform(z1[None, :])
+    )
+    rows["decode_one_latentrl_inverse_transform_variance"] = per_call(
+        lambda: model.inverse_transform(z1[None, :], return_variance=True)
     )
     rows["decode_one_numpy"] = per_call(lambda: numpy_decoder.predict_one(z1))
     mean_rs, var_rs = decoder.predict_one(z1)
@@ -278,18 +306,9 @@ def run_case(name: str, X: np.ndarray, *, quick: bool) -> dict[str, Any]:
     rows["fit_latentrl_core_gpy_budget"] = {**timing, **result}
     if gpy_model is not None:
 
-        def gpy_fit() -> Any:
-            m = gpy_gplvm(centred, start, np.exp(theta0))
-            m.optimize("lbfgsb", max_iters=FIT_ITERS)
-            return m
-
-        timing, m = once(gpy_fit, fit_repeats)
-        run = m.optimization_runs[-1]
+        row, m = gpy_fit(lambda: gpy_gplvm(centred, start, np.exp(theta0)), fit_repeats)
         rows["fit_gpy"] = {
-            **timing,
-            "nll": float(m.objective_function()),
-            "evaluations": int(run.funct_eval),
-            "stop": run.status,
+            **row,
             "theta": [
                 float(m.rbf.variance[0]),
                 float(m.rbf.lengthscale[0]) ** 2,
@@ -325,6 +344,9 @@ def run_case(name: str, X: np.ndarray, *, quick: bool) -> dict[str, Any]:
             lambda: gpy_model.infer_newX(y1), min_time=0.5, repeats=3, warmup=1
         )
 
+    back_constrained(X, centred, start, theta0, x1, rows, agreement, fit_repeats)
+    rows["fit_latentrl_GPLVM_profile"] = profile_fit(X, rows["fit_gpy"]["nll"] if "fit_gpy" in rows else None)
+
     return {
         "N": int(X.shape[0]),
         "D": int(X.shape[1]),
@@ -332,6 +354,93 @@ def run_case(name: str, X: np.ndarray, *, quick: bool) -> dict[str, Any]:
         "rows": rows,
         "agreement": agreement,
     }
+
+
+def gpy_fit(build: Callable[[], Any], repeats: int) -> tuple[dict[str, Any], Any]:
+    """Times building a GPy model with `build` and `optimize("lbfgsb", max_iters=FIT_ITERS)`:
+    its row (timing, final NLL, evaluations, stop) and the last fitted model."""
+
+    def fit() -> Any:
+        m = build()
+        m.optimize("lbfgsb", max_iters=FIT_ITERS)
+        return m
+
+    timing, m = once(fit, repeats)
+    run = m.optimization_runs[-1]
+    row = {**timing, "nll": float(m.objective_function()), "evaluations": int(run.funct_eval), "stop": run.status}
+    return row, m
+
+
+def back_constrained(
+    X: np.ndarray,
+    centred: np.ndarray,
+    start: np.ndarray,
+    log_theta: np.ndarray,
+    x1: np.ndarray,
+    rows: dict[str, Any],
+    agreement: dict[str, float],
+    repeats: int,
+) -> None:
+    """The back-constrained rows: our fit and GPy's BCGPLVM from the same start, the NLLs of
+    both at that start, and one posture encoded by the back-constraint."""
+    timing, bc = once(
+        lambda: GPLVM(2, max_iter=FIT_ITERS, noise_floor=NOISE_FLOOR, encoder="back_constrained").fit(X), repeats
+    )
+    rows["fit_latentrl_back_constrained"] = {
+        **timing,
+        "nll": bc.nll_,
+        "iterations": bc.n_iter_,
+        "converged": bool(bc.converged_),
+        "stop": bc.stop_reason_,
+        "note": "GPLVM(encoder='back_constrained').fit",
+    }
+    rows["encode_one_latentrl_back_constrained_predict_one"] = per_call(lambda: bc.encoder_.predict_one(x1))
+    rows["encode_one_latentrl_back_constrained_transform"] = per_call(lambda: bc.transform(x1[None, :]))
+    if GPy is None:
+        return
+    log_beta = float(np.log(np.median(pdist(centred, "sqeuclidean"))))
+    weights = start_weights(start, centred, log_beta)
+    theta = np.exp(np.maximum(log_theta, [-np.inf, -np.inf, np.log(NOISE_FLOOR)]))
+    ours = gplvm_back_constrained_nll_grad(weights, centred, np.log(theta), log_beta)[0]
+    agreement["nll_gpy_back_constrained_at_start"] = abs(
+        ours - float(gpy_bcgplvm(centred, weights, theta, log_beta).objective_function())
+    )
+
+    rows["fit_gpy_bcgplvm"] = gpy_fit(lambda: gpy_bcgplvm(centred, weights, theta, log_beta), repeats)[0]
+
+
+def profile_fit(X: np.ndarray, target_nll: float | None) -> dict[str, Any]:
+    """Where `GPLVM.fit`'s time goes: the native NLL + gradient of the GPLVM objective and of
+    the GP encoder's (both through `latentrl._base.gplvm_nll_grad`), the encoder fit as a whole,
+    and the rest (SciPy's L-BFGS-B, the Python objective wrapper, PCA, the maps); and when the
+    GPLVM objective first came to `target_nll` (GPy's final NLL) or below."""
+    spent: dict[str, Any] = {"native_s": 0.0, "native_calls": 0, "encoder_fit_s": 0.0, "reached_target_s": None}
+    native, encoder_fit = latentrl._base.gplvm_nll_grad, latentrl.gplvm.fit_gp_encoder
+    started = time.perf_counter()
+
+    def timed_native(*args: Any) -> Any:
+        t = time.perf_counter()
+        out = native(*args)
+        spent["native_s"] += time.perf_counter() - t
+        spent["native_calls"] += 1
+        if spent["reached_target_s"] is None and target_nll is not None and out[0] <= target_nll:
+            spent["reached_target_s"] = time.perf_counter() - started
+            spent["reached_target_calls"] = spent["native_calls"]
+        return out
+
+    def timed_encoder_fit(*args: Any, **kwargs: Any) -> Any:
+        t = time.perf_counter()
+        out = encoder_fit(*args, **kwargs)
+        spent["encoder_fit_s"] += time.perf_counter() - t
+        return out
+
+    latentrl._base.gplvm_nll_grad, latentrl.gplvm.fit_gp_encoder = timed_native, timed_encoder_fit
+    try:
+        GPLVM(2, max_iter=FIT_ITERS, noise_floor=NOISE_FLOOR).fit(X)
+        total = time.perf_counter() - started
+    finally:
+        latentrl._base.gplvm_nll_grad, latentrl.gplvm.fit_gp_encoder = native, encoder_fit
+    return {"median_s": total, **spent, "rest_s": total - spent["native_s"]}
 
 
 CASES: dict[str, tuple[str, Callable[[np.random.Generator], np.ndarray]]] = {
@@ -356,7 +465,9 @@ def fit_over_seeds(
         t0 = time.perf_counter()
         row["latentrl_core_gpy_budget"] = latentrl_fit_same_budget(start, centred, theta0)["nll"]
         row["latentrl_core_seconds"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
         fitted = GPLVM(2, max_iter=FIT_ITERS, noise_floor=NOISE_FLOOR).fit(X)
+        row["latentrl_GPLVM_seconds"] = time.perf_counter() - t0
         row["latentrl_GPLVM"] = float(fitted.nll_)
         if GPy is not None:
             m = gpy_gplvm(centred, start, np.exp(theta0))
@@ -416,6 +527,14 @@ def ratios(case: dict[str, Any]) -> dict[str, float]:
     ratio(
         "decode_one_numpy_over_predict_one", "decode_one_numpy", "decode_one_latentrl_predict_one"
     )
+    ratio(
+        "decode_one_gpy_over_inverse_transform_variance",
+        "decode_one_gpy_predict",
+        "decode_one_latentrl_inverse_transform_variance",
+    )
+    ratio("fit_gpy_over_latentrl_GPLVM", "fit_gpy", "fit_latentrl_GPLVM")
+    ratio("fit_back_constrained_over_plain", "fit_latentrl_back_constrained", "fit_latentrl_GPLVM")
+    ratio("fit_gpy_bcgplvm_over_latentrl", "fit_gpy_bcgplvm", "fit_latentrl_back_constrained")
     ratio("decode_10k_gpy_over_latentrl", "decode_10k_gpy_predict", "decode_10k_latentrl_predict")
     ratio("decode_10k_numpy_over_latentrl", "decode_10k_numpy_mean", "decode_10k_latentrl_predict")
     ratio("nll_grad_gpy_over_latentrl", "nll_grad_gpy", "nll_grad_latentrl")
@@ -441,7 +560,35 @@ def ratios(case: dict[str, Any]) -> dict[str, float]:
         out["fit_nll_latentrl_default_minus_gpy"] = (
             rows["fit_latentrl_GPLVM"]["nll"] - rows["fit_gpy"]["nll"]
         )
+    if "fit_gpy_bcgplvm" in rows:
+        out["fit_nll_back_constrained_latentrl_minus_gpy"] = (
+            rows["fit_latentrl_back_constrained"]["nll"] - rows["fit_gpy_bcgplvm"]["nll"]
+        )
     return out
+
+
+def issue19_goals(name: str, case: dict[str, Any]) -> dict[str, bool]:
+    """Issue #19's speed goals, met or not, each named with its measured number."""
+    rows, r = case["rows"], case["ratios"]
+    goals: dict[str, bool] = {}
+    encode = rows["encode_one_latentrl_back_constrained_transform"]["median_s"] * 1e6
+    native = rows["encode_one_latentrl_back_constrained_predict_one"]["median_s"] * 1e6
+    goals[f"{name}: back-constrained encode of one posture ≤ 5 µs (transform {encode:.1f} µs, "
+          f"native predict_one {native:.1f} µs)"] = encode <= 5
+    bc_ratio = r["fit_back_constrained_over_plain"]
+    goals[f"{name}: back-constrained fit ≤ 2× the plain fit ({bc_ratio:.2f}×)"] = bc_ratio <= 2
+    if "decode_one_gpy_over_inverse_transform_variance" in r:
+        decode = r["decode_one_gpy_over_inverse_transform_variance"]
+        goals[f"{name}: decode mean + variance through inverse_transform ≥ 50× GPy's predict ({decode:.1f}×)"] = (
+            decode >= 50
+        )
+    if "fit_gpy_over_latentrl_GPLVM" in r:
+        speed, gap = r["fit_gpy_over_latentrl_GPLVM"], r["fit_nll_latentrl_default_minus_gpy"]
+        reached = rows["fit_latentrl_GPLVM_profile"]["reached_target_s"]
+        early = "never" if reached is None else f"{rows['fit_gpy']['median_s'] / reached:.1f}× GPy's fit time"
+        goals[f"{name}: GPLVM.fit ≥ 3× faster than GPy's fit ({speed:.2f}×) to an NLL no worse "
+              f"(ours − GPy's {gap:+.2f}; GPy's final NLL first reached: {early})"] = speed >= 3 and gap <= 0
+    return goals
 
 
 def machine() -> dict[str, Any]:
@@ -516,7 +663,8 @@ def main(argv: list[str] | None = None) -> int:
             gpy = f"{row['gpy']:.2f} ({row['gpy_seconds']:.2f} s)" if "gpy" in row else "–"
             print(
                 f"  {name} seed {row['seed']}: latentrl core {row['latentrl_core_gpy_budget']:.2f} "
-                f"({row['latentrl_core_seconds']:.2f} s), GPLVM.fit {row['latentrl_GPLVM']:.2f}, GPy {gpy}"
+                f"({row['latentrl_core_seconds']:.2f} s), GPLVM.fit {row['latentrl_GPLVM']:.2f} "
+                f"({row['latentrl_GPLVM_seconds']:.2f} s), GPy {gpy}"
             )
 
     targets = {}
@@ -536,6 +684,8 @@ def main(argv: list[str] | None = None) -> int:
                 f"{name}: fit NLL no worse than GPy's, same start and budget (median over {len(diffs)} seeds; "
                 f"no worse in {wins})"
             ] = bool(np.median(diffs) <= 0)
+    for name, case in cases.items():
+        targets.update(issue19_goals(name, case))
     for target, ok in targets.items():
         print(f"{'PASS' if ok else 'MISS'}  {target}")
 

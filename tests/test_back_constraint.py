@@ -85,8 +85,13 @@ def test_the_experiments_take_the_encoder_as_a_checked_preset_field(model):
     from latentrl.experiments.latent_runs import gplvm_info
 
     assert Exp2Preset().encoder == "gp"
-    with pytest.raises(ValueError, match="encoder: expected one of gp, back_constrained, got 'projection'"):
-        Exp2Preset(encoder="projection").validate()
+    with pytest.raises(ValueError, match="encoder: expected one of gp, projection, back_constrained, got 'pca'"):
+        Exp2Preset(encoder="pca").validate()
+    Exp2Preset(encoder="projection").validate()
+    from latentrl.experiments.exp1 import Exp1Preset
+
+    with pytest.raises(ValueError, match="encoder: Exp 1's learner takes gp or back_constrained, got 'projection'"):
+        Exp1Preset(encoder="projection").validate()
     assert gplvm_info(model)["encoder"] == "back_constrained"
 
 

@@ -54,6 +54,7 @@ def arms_kwargs(fitted, **overrides):
         ({"test_episodes": 2, "record_test_episodes": [2]}, r"record_test_episodes\[i\] must lie in \[0, 1\]"),
         ({"record_episodes": [3]}, r"record_episodes\[i\] must lie in \[0, 2\]"),
         ({"decoder": "not a map"}, "decoder: expected a GpMap"),
+        ({"encoder": "not a map"}, "encoder: expected a GpMap or a Projection, got str"),
         ({"latent_low": np.zeros(3)}, r"latent_low: expected shape \(2,\)"),
         ({"latent_high": np.array([1.0, np.nan])}, "non-finite"),
         ({"progress": 1}, "progress: expected a callable"),
@@ -197,6 +198,29 @@ def test_same_seed_same_returns_and_a_missing_trial_is_rerun_identically(tmp_pat
         assert whole.files == resumed.files
         for key in whole.files:
             np.testing.assert_array_equal(whole[key], resumed[key], err_msg=key)
+
+
+def test_the_projection_encoder_runs_in_the_native_loop(tmp_path, fitted):
+    """`encoder="projection"`: the native loop encodes with the Rust projection (recorded in the
+    preset; the fit is the "gp" model's), deterministically, and not as the GP encoder does; a
+    policy acts through the same map."""
+    tiny = dataclasses.replace(TINY, trials=1, encoder="projection")
+    a = run_experiment("exp2", tiny, tmp_path / "a", progress=False)
+    b = run_experiment("exp2", tiny, tmp_path / "b", progress=False)
+    run_experiment("exp2", dataclasses.replace(tiny, encoder="gp"), tmp_path / "gp", progress=False)
+    assert a["trials"] == b["trials"]
+    saved = json.loads((tmp_path / "a" / "results.json").read_text())
+    assert (saved["preset"]["encoder"], saved["setup"]["gplvm"]["encoder"]) == ("projection", "gp")
+    with np.load(tmp_path / "a" / "returns.npz") as projected, np.load(tmp_path / "gp" / "returns.npz") as gp:
+        assert not np.array_equal(projected["latent_paths"], gp["latent_paths"])
+    from latentrl import _native
+
+    projection = fitted.model.native_projection_
+    learner = arms().to_dict()["learner"]
+    policy = _native.LatentPolicy(learner, list(fitted.low), list(fitted.high), np.zeros(400),
+                                  fitted.model.decoder_, projection)
+    posture = fitted.demos[3] + 0.01
+    np.testing.assert_array_equal(policy.act(posture)[1], projection.encode_one(posture))
 
 
 def test_preset_validation():

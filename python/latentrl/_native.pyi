@@ -17,6 +17,7 @@ __all__ = [
     "LatentPolicy",
     "LatentrlError",
     "NumericalError",
+    "Projection",
     "Sim",
     "Task",
     "TaskPlant",
@@ -89,6 +90,26 @@ class GpMap:
     @property
     def theta(self) -> list[float]:
         """(θ1, θ2, θ3)."""
+
+@final
+class Projection:
+    """The iterative-projection encoder posture → latent of a GPLVM decoder (docs/encoders.md)."""
+
+    def __new__(
+        cls, decoder: GpMap, postures: NDArray[np.float64], *, max_iter: int = 200, margin: float = 0.5
+    ) -> Projection:
+        """The projection under `decoder` (a GpMap latent → posture) fitted to `postures` (N, D),
+        with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`."""
+    def encode(self, postures: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Latent points (M, d) of `postures` (M, D), in parallel."""
+    def encode_one(self, posture: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The latent point (d,) of one `posture` (D,): the call the Rust RL loop makes each step."""
+    @property
+    def input_dim(self) -> int:
+        """Posture dimension D."""
+    @property
+    def output_dim(self) -> int:
+        """Latent dimension d."""
 
 @final
 class Sim:
@@ -344,7 +365,7 @@ class LatentPolicy:
         high: Sequence[float],
         weights: NDArray[np.float64],
         decoder: GpMap,
-        encoder: GpMap,
+        encoder: GpMap | Projection,
     ) -> LatentPolicy:
         """The policy of `learner` over [low, high] with `weights`."""
     def act(
@@ -358,7 +379,7 @@ def run_task_trials(
     task: Task,
     *,
     decoder: GpMap,
-    encoder: GpMap,
+    encoder: GpMap | Projection,
     latent_low: ArrayLike,
     latent_high: ArrayLike,
     n_trials: int,

@@ -111,7 +111,13 @@ class GPLVM(Estimator):
     encoder_ : GpMap
         Posture → Z: the out-of-sample GP encoder, or the back-constraint.
     projection_ : Projection
-        Posture → Z by iterative projection.
+        Posture → Z by iterative projection (SciPy L-BFGS-B; what `transform` uses).
+    native_projection_ : latentrl._native.Projection
+        The same iterative projection in Rust, the one the RL loop runs (docs/encoders.md:
+        how closely the two agree).
+    loop_encoder_ : GpMap or latentrl._native.Projection
+        The posture → Z map of the native RL loop, by the `encoder` parameter: `encoder_`, or
+        `native_projection_` for "projection".
     n_features_in_ : int
         Number of joints D.
     feature_names_in_ : ndarray (D,) of str objects
@@ -272,6 +278,13 @@ class GPLVM(Estimator):
         else:
             self.encoder_ = GpMap(self.X_train_, self.Z_, self.encoder_theta_)
         self.projection_ = Projection(self.Z_, self.X_train_, self.theta_, self.decoder_.jitter)
+        self.native_projection_ = _native.Projection(self.decoder_, self.X_train_)
+
+    @property
+    def loop_encoder_(self) -> GpMap | _native.Projection:
+        """The posture → Z map of the native RL loop, by the `encoder` parameter: `encoder_`, or
+        `native_projection_` for "projection"."""
+        return self.native_projection_ if self.encoder == "projection" else self.encoder_
 
     @property
     def fitted_encoder_(self) -> str:

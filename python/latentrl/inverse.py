@@ -50,7 +50,11 @@ class Projection:
     density from there. Started on the density directly, L-BFGS leaves the data at once:
     where σ² is tiny a small residual costs more than moving to where σ² is large. The
     search stays inside the bounding box of the latent points widened by `margin` of its
-    extent per side, and the best of start and both stages (by density) is kept."""
+    extent per side, and the best of start and both stages (by density) is kept.
+
+    `latentrl._native.Projection` is the same algorithm in Rust, the one the RL loop runs
+    (`GPLVM.native_projection_`); this SciPy version is its independent reference
+    (tests/test_inverse.py, docs/encoders.md)."""
 
     def __init__(
         self,

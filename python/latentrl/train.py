@@ -155,7 +155,7 @@ class LatentPolicy:
         the frozen test episodes (`test_*`); each (trials, episodes)."""
         learner = task.to_dict()["learner"]
         self._native = [
-            _native.LatentPolicy(learner, list(self.latent_low), list(self.latent_high), w, model.decoder_, model.encoder_)
+            _native.LatentPolicy(learner, list(self.latent_low), list(self.latent_high), w, model.decoder_, model.loop_encoder_)
             for w in self.weights
         ]
 
@@ -193,7 +193,7 @@ class LatentPolicy:
         runs = []
         for t in trials:
             runs.append(_native.run_task_trials(
-                self.task._native, decoder=self.model.decoder_, encoder=self.model.encoder_,
+                self.task._native, decoder=self.model.decoder_, encoder=self.model.loop_encoder_,
                 latent_low=self.latent_low, latent_high=self.latent_high, demos=self.demos, n_trials=1,
                 episodes=episodes, base_seed=seed, first_trial=t, weights=self.weights[t], rollout=True,
                 record_episodes=list(range(min(episodes, 20))), progress=progress,

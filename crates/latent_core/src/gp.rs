@@ -14,12 +14,15 @@ use crate::kernel::{SeKernel, factorize};
 /// pre-computed done once: the Cholesky factor `L` of `K` and `α = K⁻¹ (Y − mean)`.
 #[derive(Debug, Clone)]
 pub struct GpMap {
-    kernel: SeKernel,
-    inputs: DMatrix<f64>,
+    pub(crate) kernel: SeKernel,
+    /// Training inputs (q×N).
+    pub(crate) inputs: DMatrix<f64>,
     /// `αᵀ` (p×N), so the mean is one matrix–vector product.
-    alpha_t: DMatrix<f64>,
-    lower: DMatrix<f64>,
-    mean: DVector<f64>,
+    pub(crate) alpha_t: DMatrix<f64>,
+    /// Cholesky factor of `K` (jitter included).
+    pub(crate) lower: DMatrix<f64>,
+    /// Output mean (p).
+    pub(crate) mean: DVector<f64>,
     jitter: f64,
 }
 

@@ -5,21 +5,25 @@
 
 pub mod back_constraint;
 pub mod config;
+pub mod encode;
 pub mod episode;
 pub mod error;
 pub mod gp;
 pub mod gplvm;
 pub mod kernel;
+pub mod lbfgs;
 pub mod learner;
 pub mod params;
 pub mod plant;
 pub mod policy;
+pub mod projection;
 pub mod rbf;
 pub mod space;
 pub mod td;
 pub mod trials;
 
 pub use config::{ActionSet, LearnerConfig};
+pub use encode::{Encode, EncodeScratch};
 pub use episode::{Bounds, EpisodeRecord, EpisodeScratch, StepResult, TransitionScratch, refused, transition};
 pub use error::{CoreError, Result};
 pub use gp::{GpMap, PredictScratch};
@@ -29,6 +33,7 @@ pub use learner::{EpisodeRules, Learner, Phase, StartMode};
 pub use params::{Check, FieldInfo, Kind, ParamError, Params, Rule};
 pub use plant::{EndReason, Plant, StepOutcome};
 pub use policy::SoftmaxPolicy;
+pub use projection::{Projection, ProjectionConfig, ProjectionScratch};
 pub use rbf::{RbfConfig, RbfGrid, SparseFeatures};
 pub use space::StateSpace;
 pub use td::TdLearner;

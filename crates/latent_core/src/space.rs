@@ -1,21 +1,21 @@
 //! The learner's state space relative to the plant's posture space: the postures
-//! themselves, or a latent space with a GP decoder and encoder (paper Sec. III-B/E).
+//! themselves, or a latent space with a GP decoder and an encoder (paper Sec. III-B/E).
 
+use crate::encode::{Encode, EncodeScratch};
 use crate::error::{CoreError, Result};
 use crate::gp::{GpMap, PredictScratch};
-
 /// The learner's state space relative to the plant's posture space.
 #[derive(Debug, Clone, Copy)]
 pub enum StateSpace<'a> {
     /// The posture space itself: decode and encode are the identity.
     Full,
     /// A latent space: `decoder` maps latent → posture (GPLVM mean, Eq. 4), `encoder`
-    /// posture → latent (out-of-sample GP or back-constraint, Sec. III-B).
+    /// posture → latent (out-of-sample GP, back-constraint or iterative projection, Sec. III-B).
     Latent {
         /// Latent → posture GP map.
         decoder: &'a GpMap,
-        /// Posture → latent GP map.
-        encoder: &'a GpMap,
+        /// Posture → latent map.
+        encoder: &'a dyn Encode,
     },
 }
 
@@ -23,7 +23,7 @@ pub enum StateSpace<'a> {
 #[derive(Debug, Clone)]
 pub struct SpaceScratch {
     decode: Option<PredictScratch>,
-    encode: Option<PredictScratch>,
+    encode: Option<EncodeScratch>,
 }
 
 impl<'a> StateSpace<'a> {
@@ -72,7 +72,7 @@ impl<'a> StateSpace<'a> {
             },
             StateSpace::Latent { decoder, encoder } => SpaceScratch {
                 decode: Some(decoder.scratch()),
-                encode: Some(encoder.scratch()),
+                encode: Some(encoder.encode_scratch()),
             },
         }
     }
@@ -98,7 +98,7 @@ impl<'a> StateSpace<'a> {
     #[inline]
     pub fn encode(&self, posture: &[f64], z: &mut [f64], s: &mut SpaceScratch) {
         match (self, s.encode.as_mut()) {
-            (StateSpace::Latent { encoder, .. }, Some(s)) => encoder.mean_into(posture, z, s),
+            (StateSpace::Latent { encoder, .. }, Some(s)) => encoder.encode_into(posture, z, s),
             _ => z.copy_from_slice(posture),
         }
     }

@@ -19,6 +19,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
+use crate::encode::Encode;
 use crate::episode::{EpisodeRecord, EpisodeScratch};
 use crate::error::{CoreError, Result};
 use crate::gp::GpMap;
@@ -177,8 +178,8 @@ where
 pub struct LatentSpace<'a> {
     /// Latent → posture GP map (GPLVM mean, Eq. 4).
     pub decoder: &'a GpMap,
-    /// Posture → latent GP map (out-of-sample GP or back-constraint).
-    pub encoder: &'a GpMap,
+    /// Posture → latent map (out-of-sample GP, back-constraint or iterative projection).
+    pub encoder: &'a dyn Encode,
     /// Lower corner of the latent box.
     pub low: &'a [f64],
     /// Upper corner of the latent box.

@@ -1,13 +1,15 @@
 //! Trials give bitwise the same results on 1 and 2 threads, and a trial the same alone or
 //! among others (STYLE: "a test compares 1 and N threads bitwise"), on a toy plant: a point
-//! on a line that earns its position and ends beyond 0.9.
+//! on a line that earns its position and ends beyond 0.9; in its own space and in a latent
+//! space encoded by the iterative projection.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use latent_core::{
-    EndReason, EpisodeRules, Learner, LearnerConfig, Plant, StartMode, StateSpace, StepOutcome, TrialOptions,
-    TrialResult, run_trials,
+    EndReason, EpisodeRules, GpMap, Learner, LearnerConfig, Plant, Projection, ProjectionConfig, SeKernel, StartMode,
+    StateSpace, StepOutcome, TrialOptions, TrialResult, run_trials,
 };
+use nalgebra::DMatrix;
 use rand::{Rng, RngExt};
 
 struct Line {
@@ -54,6 +56,11 @@ fn options() -> TrialOptions {
 }
 
 fn run_on(threads: usize, options: &TrialOptions) -> Vec<TrialResult> {
+    run_in(threads, options, &StateSpace::Full, [0.0, 1.0])
+}
+
+/// Trials in `space`, the learner's box `[low, high]`.
+fn run_in(threads: usize, options: &TrialOptions, space: &StateSpace<'_>, [low, high]: [f64; 2]) -> Vec<TrialResult> {
     let config = LearnerConfig {
         rbf_per_dim: 11,
         ..LearnerConfig::default()
@@ -63,14 +70,14 @@ fn run_on(threads: usize, options: &TrialOptions) -> Vec<TrialResult> {
         start: StartMode::Plant,
         ..EpisodeRules::default()
     };
-    let learner = Learner::new(&config, rules, &[0.0], &[1.0]).unwrap();
+    let learner = Learner::new(&config, rules, &[low], &[high]).unwrap();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let done = AtomicUsize::new(0);
     let results = pool
         .install(|| {
             run_trials(
                 &learner,
-                &StateSpace::Full,
+                space,
                 |_| Ok(Line { x: 0.0 }),
                 options,
                 &AtomicBool::new(false),
@@ -117,4 +124,25 @@ fn a_trial_is_the_same_alone_or_among_others() {
         ..options()
     };
     assert_bitwise_equal(&all[2..3], &run_on(1, &third));
+}
+
+#[test]
+fn the_projection_encoder_is_the_same_on_one_and_two_threads() {
+    // A 1-D latent line z ∈ [−1, 1] decoded to the plant's x = (z + 1) / 2 (a little bent).
+    let latent = DMatrix::from_fn(1, 9, |_, j| j as f64 / 4.0 - 1.0);
+    let postures = latent.map(|z| 0.5 * (z + 1.0) + 0.05 * z * z);
+    let decoder = GpMap::new(latent, postures.clone(), SeKernel::new([0.5, 0.3, 1e-6]).unwrap()).unwrap();
+    let projection = Projection::new(&decoder, postures, ProjectionConfig::default()).unwrap();
+    let space = StateSpace::Latent {
+        decoder: &decoder,
+        encoder: &projection,
+    };
+    let options = TrialOptions {
+        episodes: 15,
+        record_episodes: vec![0, 14],
+        ..options()
+    };
+    let a = run_in(1, &options, &space, [-1.0, 1.0]);
+    assert_bitwise_equal(&a, &run_in(2, &options, &space, [-1.0, 1.0]));
+    assert_ne!(a[0].episodes, a[1].episodes, "trials draw from their own streams");
 }

@@ -80,6 +80,7 @@ pub fn run_bimanual_trials<'py>(
         let latent;
         let bimanual = if maps.iter().chain(&corners).any(|&given| given) {
             let (decoder, encoder) = (gp_map("decoder", &decoder)?, gp_map("encoder", &encoder)?);
+            let encoder = encoder.map(|map| &map.get().inner);
             latent = latent_args(decoder, encoder, latent_low, latent_high, "for the latent learner")?;
             BimanualLearner::Latent {
                 decoder: latent.decoder,

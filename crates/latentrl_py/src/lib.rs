@@ -7,6 +7,7 @@ mod errors;
 mod fallcheck;
 mod gp;
 mod kinematics;
+mod projection;
 mod runner;
 mod task;
 mod urdf;
@@ -20,6 +21,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_GP_POINTS", latent_core::gp::MAX_GP_POINTS)?;
     m.add("MAX_EPISODES", runner::MAX_EPISODES)?;
     m.add_class::<gp::PyGpMap>()?;
+    m.add_class::<projection::PyProjection>()?;
     m.add_class::<world::PySim>()?;
     m.add_class::<task::PyTask>()?;
     m.add_class::<task::PyTaskPlant>()?;

@@ -74,32 +74,29 @@ fn corner(name: &'static str, value: Option<&Bound<'_, PyAny>>, dim: usize, cont
 
 /// A latent learner's maps and box, checked: decoder and encoder given, corners of the
 /// decoder's input dimension, `high > low`. `context` ends the "is required" messages.
-pub(crate) struct LatentArgs<'a> {
+pub(crate) struct LatentArgs<'a, E: ?Sized> {
     /// Latent → posture.
     pub decoder: &'a GpMap,
     /// Posture → latent.
-    pub encoder: &'a GpMap,
+    pub encoder: &'a E,
     /// Lower corner of the latent box.
     pub low: Vec<f64>,
     /// Upper corner of the latent box.
     pub high: Vec<f64>,
 }
 
-pub(crate) fn latent_args<'a, 'py>(
+pub(crate) fn latent_args<'a, 'py, E: ?Sized>(
     decoder: Option<&'a Bound<'py, PyGpMap>>,
-    encoder: Option<&'a Bound<'py, PyGpMap>>,
+    encoder: Option<&'a E>,
     latent_low: Option<&Bound<'py, PyAny>>,
     latent_high: Option<&Bound<'py, PyAny>>,
     context: &str,
-) -> PyResult<LatentArgs<'a>> {
+) -> PyResult<LatentArgs<'a, E>> {
     let decoder: &GpMap = &decoder
         .ok_or_else(|| invalid(format!("decoder (a GpMap latent → posture) is required {context}")))?
         .get()
         .inner;
-    let encoder: &GpMap = &encoder
-        .ok_or_else(|| invalid(format!("encoder (a GpMap posture → latent) is required {context}")))?
-        .get()
-        .inner;
+    let encoder = encoder.ok_or_else(|| invalid(format!("encoder (posture → latent) is required {context}")))?;
     let dim = decoder.input_dim();
     let low = corner("latent_low", latent_low, dim, context)?;
     let high = corner("latent_high", latent_high, dim, context)?;

@@ -17,6 +17,7 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::convert::{config_from, config_to, points, to_points};
 use crate::errors::{guard, sim_to_py, to_py};
+use crate::projection::EncoderObject;
 use crate::runner::{RunArgs, check_recording, gp_map, invalid, latent_args, pack_results, run_with_polling};
 
 /// `classify`'s result: one code per posture and the effector positions.
@@ -344,8 +345,8 @@ impl PyTaskPlant {
 /// `task.episode`) in parallel in Rust, one plant per trial (a fresh world per episode for a
 /// floating robot).
 ///
-/// task: a Task. decoder, encoder: GpMap latent (d) → posture (D) and back. latent_low,
-/// latent_high: (d,) corners of the latent box. demos: (N, D) demonstrations (a "demo" start
+/// task: a Task. decoder: GpMap latent (d) → posture (D); encoder: GpMap or Projection
+/// posture → latent. latent_low, latent_high: (d,) corners of the latent box. demos: (N, D) demonstrations (a "demo" start
 /// uses row `episode.start_demo`). weights: (M,) value weights to start from (a saved policy;
 /// default w₀ everywhere). rollout: run the `episodes` frozen with the greedy policy.
 /// n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
@@ -389,10 +390,11 @@ pub fn run_task_trials<'py>(
         }
         let task = Arc::clone(&task.inner);
         let demos = rows("demos", demos)?;
-        let [decoder, encoder] = [Some(decoder), Some(encoder)];
+        let encoder = EncoderObject::extract("encoder", &encoder)?;
+        let decoder = Some(decoder);
         let maps = latent_args(
             gp_map("decoder", &decoder)?,
-            gp_map("encoder", &encoder)?,
+            Some(encoder.get()),
             Some(latent_low),
             Some(latent_high),
             "",
@@ -536,7 +538,7 @@ pub fn end_reasons() -> Vec<&'static str> {
 pub struct PyLatentPolicy {
     learner: Learner,
     decoder: Py<crate::gp::PyGpMap>,
-    encoder: Py<crate::gp::PyGpMap>,
+    encoder: EncoderObject,
 }
 
 #[pymethods]
@@ -550,21 +552,22 @@ impl PyLatentPolicy {
         high: Vec<f64>,
         weights: PyReadonlyArray1<'_, f64>,
         decoder: Bound<'_, crate::gp::PyGpMap>,
-        encoder: Bound<'_, crate::gp::PyGpMap>,
+        encoder: &Bound<'_, PyAny>,
     ) -> PyResult<Self> {
         guard(|| {
+            let encoder = EncoderObject::extract("encoder", encoder)?;
             let config: latent_core::LearnerConfig = config_from("learner", learner)?;
             let mut l = Learner::new(&config, Default::default(), &low, &high).map_err(to_py)?;
             l.set_weights(&weights.as_array().to_vec()).map_err(to_py)?;
             let space = latent_core::StateSpace::Latent {
                 decoder: &decoder.get().inner,
-                encoder: &encoder.get().inner,
+                encoder: encoder.get(),
             };
             l.check_space(&space, decoder.get().inner.output_dim()).map_err(to_py)?;
             Ok(Self {
                 learner: l,
                 decoder: decoder.unbind(),
-                encoder: encoder.unbind(),
+                encoder,
             })
         })
     }
@@ -582,7 +585,7 @@ impl PyLatentPolicy {
         Bound<'py, PyArray1<f64>>,
     )> {
         guard(|| {
-            let (decoder, encoder) = (&self.decoder.get().inner, &self.encoder.get().inner);
+            let (decoder, encoder) = (&self.decoder.get().inner, self.encoder.get());
             let x = posture.as_array().to_vec();
             if x.len() != encoder.input_dim() {
                 return Err(invalid(format!(
@@ -593,7 +596,7 @@ impl PyLatentPolicy {
             }
             latent_core::error::check_finite("posture", &x).map_err(to_py)?;
             let mut z = vec![0.0; encoder.output_dim()];
-            encoder.mean_into(&x, &mut z, &mut encoder.scratch());
+            encoder.encode_into(&x, &mut z, &mut encoder.encode_scratch());
             let next = self.learner.greedy_target(&z).map_err(to_py)?;
             let mut target = vec![0.0; decoder.output_dim()];
             decoder.mean_into(&next, &mut target, &mut decoder.scratch());

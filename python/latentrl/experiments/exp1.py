@@ -36,6 +36,9 @@ class Exp1Preset(LatentRun):
     def validate(self) -> None:
         """ValueError naming the first impossible field or key (the native rules for `task`)."""
         self.check_run()
+        if self.encoder == "projection":
+            raise ValueError("encoder: Exp 1's learner takes gp or back_constrained, got 'projection' "
+                             "(the projection runs in the task learners: Exp 2, Exp 3, latentrl train)")
         check_ints(self, ("n_demos",))
         configs(self)
 
@@ -79,7 +82,7 @@ def setup(preset: Exp1Preset) -> Setup:
         record_episodes=recorded_episodes(preset.episodes),
     )
     learners: dict[str, RunTrials] = {
-        "latent": partial(run, decoder=model.decoder_, encoder=model.encoder_, latent_low=low, latent_high=high,
+        "latent": partial(run, decoder=model.decoder_, encoder=model.loop_encoder_, latent_low=low, latent_high=high,
                           return_weights=True),
         "full": run,
     }

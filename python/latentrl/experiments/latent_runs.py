@@ -78,7 +78,7 @@ def task_learner(
         _native.run_task_trials,
         task._native,
         decoder=model.decoder_,
-        encoder=model.encoder_,
+        encoder=model.loop_encoder_,
         latent_low=low,
         latent_high=high,
         demos=np.ascontiguousarray(demos, dtype=np.float64),

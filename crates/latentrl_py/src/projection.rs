@@ -1,0 +1,112 @@
+//! Binding of `latent_core::projection`, and the one conversion of an `encoder` argument (a
+//! GpMap or a Projection) into the core's `Encode` map.
+
+use latent_core::{Encode, Projection, ProjectionConfig};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+
+use crate::convert::{points, to_points, type_name};
+use crate::errors::{InvalidInputError, guard, to_py};
+use crate::gp::PyGpMap;
+
+/// The iterative-projection encoder posture → latent of a GPLVM decoder (docs/encoders.md).
+#[pyclass(name = "Projection", module = "latentrl._native", frozen)]
+pub struct PyProjection {
+    /// The core object, also handed to Rust loops without crossing into Python.
+    pub inner: Projection,
+}
+
+#[pymethods]
+impl PyProjection {
+    /// The projection under `decoder` (a GpMap latent → posture) fitted to `postures` (N, D),
+    /// with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`.
+    #[new]
+    #[pyo3(signature = (decoder, postures, *, max_iter = 200, margin = 0.5))]
+    fn new(
+        py: Python<'_>,
+        decoder: &Bound<'_, PyGpMap>,
+        postures: PyReadonlyArray2<'_, f64>,
+        max_iter: usize,
+        margin: f64,
+    ) -> PyResult<Self> {
+        guard(|| {
+            let postures = points("postures", &postures)?;
+            let config = ProjectionConfig { max_iter, margin };
+            let decoder = &decoder.get().inner;
+            let inner = py
+                .detach(|| Projection::new(decoder, postures, config))
+                .map_err(to_py)?;
+            Ok(Self { inner })
+        })
+    }
+
+    /// Latent points (M, d) of `postures` (M, D), in parallel.
+    fn encode<'py>(
+        &self,
+        py: Python<'py>,
+        postures: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        guard(|| {
+            let postures = points("postures", &postures)?;
+            let latent = py.detach(|| self.inner.encode(&postures)).map_err(to_py)?;
+            to_points(py, latent)
+        })
+    }
+
+    /// The latent point (d,) of one `posture` (D,): the call the Rust RL loop makes each step.
+    fn encode_one<'py>(
+        &self,
+        py: Python<'py>,
+        posture: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        guard(|| {
+            let x = posture.as_array().to_vec();
+            self.inner.check_posture(&x).map_err(to_py)?;
+            let mut z = vec![0.0; self.inner.latent_dim()];
+            self.inner.encode_into(&x, &mut z, &mut self.inner.scratch());
+            Ok(PyArray1::from_vec(py, z))
+        })
+    }
+
+    /// Posture dimension D.
+    #[getter]
+    fn input_dim(&self) -> PyResult<usize> {
+        guard(|| Ok(self.inner.posture_dim()))
+    }
+
+    /// Latent dimension d.
+    #[getter]
+    fn output_dim(&self) -> PyResult<usize> {
+        guard(|| Ok(self.inner.latent_dim()))
+    }
+}
+
+/// An `encoder` argument held by a Python object: a GpMap or a Projection.
+pub(crate) enum EncoderObject {
+    Map(Py<PyGpMap>),
+    Projection(Py<PyProjection>),
+}
+
+impl EncoderObject {
+    /// `value` as an encoder; an InvalidInputError naming `name` if it is neither kind.
+    pub(crate) fn extract(name: &str, value: &Bound<'_, PyAny>) -> PyResult<Self> {
+        if let Ok(map) = value.cast::<PyGpMap>() {
+            Ok(Self::Map(map.clone().unbind()))
+        } else if let Ok(projection) = value.cast::<PyProjection>() {
+            Ok(Self::Projection(projection.clone().unbind()))
+        } else {
+            Err(InvalidInputError::new_err(format!(
+                "{name}: expected a GpMap or a Projection, got {}",
+                type_name(value)
+            )))
+        }
+    }
+
+    /// The core map.
+    pub(crate) fn get(&self) -> &dyn Encode {
+        match self {
+            Self::Map(map) => &map.get().inner,
+            Self::Projection(projection) => &projection.get().inner,
+        }
+    }
+}
