@@ -33,7 +33,7 @@ __all__ = ["BimanualReachEnv", "LatentSpaceWrapper", "TaskEnv"]
 
 Obs = NDArray[np.float64]
 
-SHIPPED_DEMOS = {"two_arms": "two_arms_demos.csv", "humanoid_lift": "khr1hv_lift_demos.csv"}
+SHIPPED_DEMOS = {"two_arms": "two_arms_demos.csv", "humanoid_lift": "khr1hv_lift_demos_bridged.csv"}
 """The demonstrations shipped for each shipped task (package data)."""
 
 
