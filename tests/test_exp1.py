@@ -109,3 +109,16 @@ def test_a_different_preset_in_the_same_directory_is_refused(tmp_path):
     run_experiment("exp1", TINY, tmp_path, progress=False)
     with pytest.raises(ValueError, match="different preset"):
         run_experiment("exp1", with_overrides(TINY, {"learner.beta": 5.0}), tmp_path, progress=False)
+
+
+def test_the_projection_encoder_runs_in_exp1s_native_loop(tmp_path):
+    """`encoder="projection"` reaches the bimanual learner: same seed, same bits, and not the GP
+    encoder's run."""
+    tiny = dataclasses.replace(TINY, trials=1, encoder="projection")
+    a = run_experiment("exp1", tiny, tmp_path / "a", progress=False)
+    b = run_experiment("exp1", tiny, tmp_path / "b", progress=False)
+    run_experiment("exp1", dataclasses.replace(tiny, encoder="gp"), tmp_path / "gp", progress=False)
+    assert a["trials"] == b["trials"]
+    assert json.loads((tmp_path / "a" / "results.json").read_text())["preset"]["encoder"] == "projection"
+    with np.load(tmp_path / "a" / "returns.npz") as projected, np.load(tmp_path / "gp" / "returns.npz") as gp:
+        assert not np.array_equal(projected["latent"], gp["latent"])

@@ -7,6 +7,7 @@ use pyo3::types::PyDict;
 
 use crate::convert::{config_from, config_to};
 use crate::errors::{guard, to_py};
+use crate::projection::EncoderObject;
 use crate::runner::{RunArgs, gp_map, latent_args, pack_results, run_with_polling};
 
 /// Runs Experiment 1 (SPEC §4.1) trials in parallel in Rust and returns their records.
@@ -20,7 +21,7 @@ use crate::runner::{RunArgs, gp_map, latent_args, pack_results, run_with_polling
 /// first_trial: run trials first_trial .. first_trial + n_trials (to resume); None means 0.
 /// plant: a dict of BimanualConfig keys (`plant_schema()`); learner: a dict of LearnerConfig
 ///     keys (`learner_schema()`); keys left out keep their defaults, unknown keys are errors.
-/// decoder, encoder: GpMap latent (d) → posture (4) and posture (4) → latent (d).
+/// decoder, encoder: a GpMap latent (d) → posture (4), and a GpMap or a Projection posture (4) → latent (d).
 /// latent_low, latent_high: (d,) corners of the latent box.
 /// record_episodes: episode indices whose hand trajectories are recorded in every trial.
 /// test_episodes: K frozen test episodes after training (no TD updates); None or 0 for none.
@@ -77,11 +78,20 @@ pub fn run_bimanual_trials<'py>(
         check_tables(&plant, &config)?;
         let maps = [&decoder, &encoder].map(|m| m.as_ref().is_some_and(|m| !m.is_none()));
         let corners = [latent_low, latent_high].map(|c| c.is_some_and(|c| !c.is_none()));
-        let latent;
+        let (latent, encoder_object);
         let bimanual = if maps.iter().chain(&corners).any(|&given| given) {
-            let (decoder, encoder) = (gp_map("decoder", &decoder)?, gp_map("encoder", &encoder)?);
-            let encoder = encoder.map(|map| &map.get().inner);
-            latent = latent_args(decoder, encoder, latent_low, latent_high, "for the latent learner")?;
+            encoder_object = encoder
+                .filter(|e| !e.is_none())
+                .map(|e| EncoderObject::extract("encoder", &e))
+                .transpose()?;
+            let encoder = encoder_object.as_ref().map(EncoderObject::get);
+            latent = latent_args(
+                gp_map("decoder", &decoder)?,
+                encoder,
+                latent_low,
+                latent_high,
+                "for the latent learner",
+            )?;
             BimanualLearner::Latent {
                 decoder: latent.decoder,
                 encoder: latent.encoder,

@@ -19,7 +19,9 @@ use std::sync::atomic::{AtomicBool, AtomicUsize};
 use latent_core::error::Result;
 use latent_core::params::{ParamError, Params, Rule};
 use latent_core::trials::{TrialOptions, TrialResult, run_trials};
-use latent_core::{EndReason, EpisodeRules, GpMap, Learner, LearnerConfig, Plant, StateSpace, StepOutcome, params};
+use latent_core::{
+    Encode, EndReason, EpisodeRules, GpMap, Learner, LearnerConfig, Plant, StateSpace, StepOutcome, params,
+};
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
@@ -208,8 +210,8 @@ pub enum BimanualLearner<'a> {
     Latent {
         /// Latent → posture GP map (GPLVM mean, Eq. 4).
         decoder: &'a GpMap,
-        /// Posture → latent GP map (out-of-sample GP).
-        encoder: &'a GpMap,
+        /// Posture → latent map (the out-of-sample GP, the back-constraint or a projection).
+        encoder: &'a dyn Encode,
         /// Lower corner of the latent box.
         low: &'a [f64],
         /// Upper corner of the latent box.

@@ -36,9 +36,6 @@ class Exp1Preset(LatentRun):
     def validate(self) -> None:
         """ValueError naming the first impossible field or key (the native rules for `task`)."""
         self.check_run()
-        if self.encoder == "projection":
-            raise ValueError("encoder: Exp 1's learner takes gp or back_constrained, got 'projection' "
-                             "(the projection runs in the task learners: Exp 2, Exp 3, latentrl train)")
         check_ints(self, ("n_demos",))
         configs(self)
 

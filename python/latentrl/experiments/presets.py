@@ -24,8 +24,8 @@ import numpy as np
 from latentrl import _native
 from latentrl._validation import int_at_least
 
-#: The encoders a latent RL run can use inside the native loop (GPLVM.loop_encoder_): all of
-#: them, but for Exp 1's learner, which takes a GpMap (`Exp1Preset.validate`).
+#: The encoders a latent RL run can use inside the native loop (GPLVM.loop_encoder_), in every
+#: experiment and `latentrl train`.
 RL_ENCODERS = ("gp", "projection", "back_constrained")
 
 
@@ -103,7 +103,7 @@ class LatentRun:
     gplvm_max_iter: int = 1000
     """L-BFGS iteration cap of the GPLVM fit."""
     encoder: str = "gp"
-    """Posture → latent map of the RL loop: "gp" (the paper's out-of-sample GP onto the fitted points), "projection" (the latent point of highest density under the decoder, iterated from the nearest demo; not Exp 1) or "back_constrained" (the GPLVM fitted with Z = g(X), encoding its demos exactly; docs/encoders.md)."""
+    """Posture → latent map of the RL loop: "gp" (the paper's out-of-sample GP onto the fitted points), "projection" (the latent point of highest density under the decoder, iterated from the nearest demo) or "back_constrained" (the GPLVM fitted with Z = g(X), encoding its demos exactly; docs/encoders.md)."""
     latent_margin: float = 0.1
     """Latent box = bounding box of the fitted latent points, widened by this share per side (ours: 10 %)."""
     task: Mapping[str, Any] = field(default_factory=dict)
