@@ -8,7 +8,8 @@ import numpy as np
 
 from latentrl import GPLVM
 from latentrl.datasets import arm_postures
-from latentrl.envs import shipped_demos
+from latentrl.demos import load_demos
+from latentrl.experiments.exp3 import demos_path
 
 
 def manifold(d, n, joints, seed):
@@ -28,7 +29,7 @@ for d in (1, 2, 3):
               f"{np.round(model.relevance_ / model.relevance_[0], 3).tolist()}")
 print(f"picked the generating d in {hits} of 24")
 for name, X, k in (("arms (Exp 2, 123 postures, 4 joints)", arm_postures(123, np.random.default_rng(0)), 3),
-                   ("humanoid lift (Exp 3, 7 demos, 19 joints)", shipped_demos("humanoid_lift"), 5)):
+                   ("humanoid lift (the paper's 7 demos, 19 joints)", load_demos(demos_path()).postures, 5)):
     model = GPLVM(n_components="auto", max_components=k, random_state=0).fit(X)
     print(f"{name}: picks {model.n_components_} (paper: 2), relative relevances "
           f"{np.round(model.relevance_ / model.relevance_[0], 3).tolist()}")

@@ -112,8 +112,9 @@ def test_the_plant_classifies_postures_by_the_task_rules():
     arms = Task.shipped("two_arms")
     plant = arms.plant()
     demos = shipped_demos("two_arms")
-    codes, effectors = plant.classify(demos[:10])
-    assert codes.shape == (10,) and effectors.shape == (10, 6)
+    codes, effectors, targets = plant.classify(demos[:10])
+    assert codes.shape == (10,) and effectors.shape == targets.shape == (10, 6)
+    np.testing.assert_array_equal(targets, np.tile(np.ravel(arms.to_dict()["target"]["position"]), (10, 1)))
     assert set(codes) <= {0, 1, 3}, "demos hold the object; some touch the walls"
     assert np.allclose(effectors[:, 3] - effectors[:, 0], 0.1, atol=0.005) or (codes != 0).any()
     bad = demos[:1].copy()
@@ -121,8 +122,8 @@ def test_the_plant_classifies_postures_by_the_task_rules():
     assert plant.classify(bad)[0][0] == 2, "outside the joint limits"
     lift = Task.shipped("humanoid_lift")
     d = shipped_demos("humanoid_lift")
-    codes, _ = lift.plant(d).classify(d)
-    np.testing.assert_array_equal(codes, [1, 1, 1, 0, 0, 0, 0])
+    codes, _, _ = lift.plant(d).classify(d)
+    np.testing.assert_array_equal(codes, [1, 1, 1] + [0] * 11)
     with pytest.raises(ValueError, match=r"postures: expected shape \(M, 19\)"):
         lift.plant(d).classify(np.zeros((2, 4)))
 

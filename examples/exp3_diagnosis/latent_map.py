@@ -21,7 +21,7 @@ n = 60
 gx = np.linspace(f.low[0], f.high[0], n); gy = np.linspace(f.low[1], f.high[1], n)
 Z = np.array([[x, y] for y in gy for x in gx])
 X = f.model.inverse_transform(Z)
-codes, hands = plant.classify(X)
+codes, hands, _ = plant.classify(X)
 codes = codes.reshape(n, n); hz = np.maximum(hands[:, 2], hands[:, 5]).reshape(n, n)
 names = end_reasons()
 print("latent box", f.low, f.high)

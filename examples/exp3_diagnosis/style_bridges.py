@@ -14,11 +14,11 @@ import numpy as np
 from scipy.optimize import minimize
 
 from latentrl import Task
-from latentrl.demos import Demonstrations, save_demos
-from latentrl.envs import shipped_demos
+from latentrl.demos import Demonstrations, load_demos, save_demos
+from latentrl.experiments.exp3 import demos_path
 
 task = Task.shipped("humanoid_lift")
-demos = shipped_demos("humanoid_lift")
+demos = load_demos(demos_path(), expected_joints=task.joint_names).postures  # the paper's 7
 plant = task.plant(demos)
 J = {n: i for i, n in enumerate(task.joint_names)}
 PARAMS = ("shoulder_pitch", "shoulder_roll", "elbow", "hip_pitch", "knee", "ankle_pitch")

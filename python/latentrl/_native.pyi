@@ -325,13 +325,15 @@ class TaskPlant:
         the rule it breaks."""
     def step(self, target: NDArray[np.float64]) -> tuple[float, int | None, NDArray[np.float64]]:
         """Tracks `target` (D,) for one RL step: `(reward, end code or None, reached posture (D,))`."""
-    def classify(self, postures: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
-        """For each posture (M, D) at rest: the code of the rule it breaks (0: none) and the
-        effector positions (M, 3E)."""
+    def classify(self, postures: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64], NDArray[np.float64]]:
+        """For each posture (M, D) at rest: the code of the rule it breaks (0: none), the
+        effector positions (M, 3E) and the target's (M, 3E) in the world."""
     def sample_start(self, seed: int) -> NDArray[np.float64]:
         """A start posture drawn by the task's start rule from ChaCha8 seeded with `seed`."""
     def effectors(self) -> NDArray[np.float64]:
         """The effector positions (3E,): x, y, z per effector."""
+    def target_position(self) -> NDArray[np.float64]:
+        """The target h* in the world now (E, 3), moved with `target.relative_to` if set."""
     def joint_positions(self) -> NDArray[np.float64]:
         """The reached joint positions (D,)."""
     def targets(self) -> NDArray[np.float64]:

@@ -38,7 +38,7 @@ def view_axes(task: Task) -> tuple[int, int]:
 def draw_task(task: Task, plant: _native.TaskPlant, size: int = 400) -> NDArray[np.uint8]:
     """An RGB image (size, size, 3) of the task's robot as the plant holds it now."""
     fig, ax = _canvas(size)
-    draw_scene(ax, Scene.of(task), np.asarray(plant.link_poses()))
+    draw_scene(ax, Scene.of(task, plant), np.asarray(plant.link_poses()))
     return _pixels(fig)
 
 
@@ -55,9 +55,11 @@ class Scene:
     target: NDArray[np.float64]
 
     @classmethod
-    def of(cls, task: Task) -> Scene:
+    def of(cls, task: Task, plant: _native.TaskPlant) -> Scene:
+        """The scene of `task`, its target where `plant` holds it now (a target measured from a
+        link, `target.relative_to`, moves with it)."""
         config = task.to_dict()
-        target = np.asarray(config["target"]["position"], dtype=np.float64).reshape(-1, 3)
+        target = np.asarray(plant.target_position(), dtype=np.float64)
         return cls(view_axes(task), config, tuple(task.link_names), tuple(task.edges),
                    tuple(task._native.collision_shapes()), target)
 

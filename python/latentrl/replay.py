@@ -103,7 +103,8 @@ def recorded(experiment: str, preset: Any, rows: NDArray[np.float64], weights: N
     base = rows[:, np.r_[slices["base_position"], slices["base_quaternion"]]]
     plant = task.plant()
     poses = np.stack([np.asarray(plant.pose_links(b, q)) for b, q in zip(base, joints)])
-    scene = Scene.of(task)
+    plant.pose_links(base[0], joints[0])
+    scene = Scene.of(task, plant)  # the target where it stands at the episode's start
     return Recorded(f"{task.name}: {title}", rows[:, slices["effectors"]].reshape(len(rows), -1, 3),
                     model.transform(joints), weights, low, high, model, scene.config["learner"], scene=scene,
                     poses=poses)

@@ -145,6 +145,7 @@ pub fn transition<P: Plant>(
 #[derive(Debug, Clone)]
 pub struct EpisodeScratch {
     z: Vec<f64>,
+    mean_z: Vec<f64>,
     candidate: Vec<f64>,
     q: Vec<f64>,
     q_buffer: Vec<f64>,
@@ -160,6 +161,12 @@ impl EpisodeScratch {
         &self.z
     }
 
+    /// The mean of the learner's state over the last episode: its start and every state a
+    /// non-terminal step reached (where in the state space the episode went).
+    pub fn mean_state(&self) -> &[f64] {
+        &self.mean_z
+    }
+
     /// The last posture the plant reached (or was reset to).
     pub fn posture(&self) -> &[f64] {
         &self.step.reached
@@ -172,6 +179,7 @@ impl Learner {
         let dim = self.grid.dim();
         EpisodeScratch {
             z: vec![0.0; dim],
+            mean_z: vec![0.0; dim],
             candidate: vec![0.0; dim],
             q: vec![0.0; self.n_actions],
             q_buffer: vec![0.0; self.n_actions],
@@ -305,6 +313,8 @@ impl Learner {
             reached: false,
             passed: false,
         };
+        s.mean_z.copy_from_slice(&s.z);
+        let mut states = 1.0;
         while record.steps < self.rules.max_steps {
             let r = self.step(plant, space, rng, s);
             record.steps += 1;
@@ -318,7 +328,10 @@ impl Learner {
                 record.end = end;
                 break;
             }
+            s.mean_z.iter_mut().zip(&s.z).for_each(|(m, z)| *m += z);
+            states += 1.0;
         }
+        s.mean_z.iter_mut().for_each(|m| *m /= states);
         Ok(record)
     }
 }
@@ -506,6 +519,15 @@ mod tests {
                 .unwrap();
             assert!(traj[0] < 0.3, "test start {} not admitted by the plant", traj[0]);
             assert_eq!(rec.passed, traj[1..].iter().any(|&x| x > 0.7));
+            // The mean state: over the start and every non-terminal step's state (the full
+            // space's state is the reached x, the recorded row).
+            let states = 1 + rec.steps - usize::from(rec.end != EndReason::TimeOut);
+            let mean = traj[..states].iter().sum::<f64>() / states as f64;
+            assert!(
+                (s.mean_state()[0] - mean).abs() < 1e-12,
+                "{:?} vs {mean}",
+                s.mean_state()
+            );
             passes += usize::from(rec.passed);
         }
         assert!(passes > 0);

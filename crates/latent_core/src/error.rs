@@ -59,7 +59,8 @@ pub enum CoreError {
     /// No admissible episode start was found.
     #[error(
         "no admissible start state in {draws} draws: every drawn start was refused by the plant \
-         (obstacle, drop, box) or by variance gating; check the start distribution and the box"
+         (obstacle, drop, box, or for a frozen test episode the plant's test-start rule) or by \
+         variance gating; check the start distribution, the test-start rule and the box"
     )]
     NoValidStart {
         /// How many starts were drawn.

@@ -139,6 +139,9 @@ pub struct TrialResult {
     /// The task-space row at the start of every test episode run, concatenated (`task_dim`
     /// values each): where each frozen test started (e.g. the hands at floor level or not).
     pub test_starts: Vec<f64>,
+    /// The learner's mean state over every training episode run (`EpisodeScratch::mean_state`),
+    /// concatenated (the learner's dimension each): where each episode went.
+    pub mean_states: Vec<f64>,
 }
 
 /// Runs `options.n_trials` trials in parallel (rayon's current pool). Each trial clones
@@ -243,7 +246,9 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
         cancel,
         done,
     };
-    let (episodes, trajectories, mut finished) = run.block(options.episodes, &options.record_episodes, None)?;
+    let mut mean_states = Vec::new();
+    let (episodes, trajectories, mut finished) =
+        run.block(options.episodes, &options.record_episodes, None, Some(&mut mean_states))?;
     let (mut tests, mut test_trajectories) = (Vec::new(), vec![Vec::new(); options.record_test_episodes.len()]);
     let mut test_starts = Vec::new();
     if finished && options.test_episodes > 0 {
@@ -252,6 +257,7 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
             options.test_episodes,
             &options.record_test_episodes,
             Some(&mut test_starts),
+            None,
         )?;
     }
     let weights = options.keep_weights.then(|| run.learner.into_weights());
@@ -264,6 +270,7 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
         tests,
         test_trajectories,
         test_starts,
+        mean_states,
     })
 }
 
@@ -280,13 +287,15 @@ struct TrialRun<'a, P> {
 
 impl<P: Plant> TrialRun<'_, P> {
     /// Runs `n` episodes in the learner's current phase, recording the trajectories of the
-    /// episodes listed in `record` (and, with `starts`, the first row of every episode);
-    /// returns the records, the trajectories and whether the block finished (false if cancelled).
+    /// episodes listed in `record` (and, with `starts`, the first row of every episode; with
+    /// `means`, every episode's mean state); returns the records, the trajectories and whether
+    /// the block finished (false if cancelled).
     fn block(
         &mut self,
         n: usize,
         record: &[usize],
         mut starts: Option<&mut Vec<f64>>,
+        mut means: Option<&mut Vec<f64>>,
     ) -> Result<(Vec<EpisodeRecord>, Vec<Vec<f64>>, bool)> {
         let mut episodes = Vec::with_capacity(n);
         let mut trajectories = vec![Vec::new(); record.len()];
@@ -306,6 +315,9 @@ impl<P: Plant> TrialRun<'_, P> {
             };
             if let Some(starts) = starts.as_deref_mut() {
                 starts.extend_from_slice(&buffer[..task_dim]);
+            }
+            if let Some(means) = means.as_deref_mut() {
+                means.extend_from_slice(self.scratch.mean_state());
             }
             // The same episode may be listed twice: every listed slot gets the trajectory.
             for (slot, r) in trajectories.iter_mut().zip(record) {

@@ -37,7 +37,8 @@ use crate::runner::{RunArgs, gp_map, latent_args, pack_results, run_with_polling
 /// "trials" (T,) int64, "trajectories" (T, R, max_steps + 1, 4) float64 hands (x_L, y_L,
 /// x_R, y_R) after the reset and after each plant step, NaN-padded, "test_trajectories"
 /// likewise, "test_starts" (T, K, 4) the row at the start of every test episode (NaN where
-/// not run), "weights" (T, M) float64 or None, "learner_low" / "learner_high" / "spacing"
+/// not run), "mean_states" (T, E, n) each training episode's mean learner state (n: 4 full,
+/// d latent; NaN where not run), "weights" (T, M) float64 or None, "learner_low" / "learner_high" / "spacing"
 /// (d,) of the RBF grid, "n_actions", "n_centres", and "plant" / "learner" (the effective
 /// configurations). Ctrl-C stops all trials and raises KeyboardInterrupt.
 #[pyfunction]

@@ -302,16 +302,18 @@ pub(crate) fn pack_results<'py>(
     paths("test_trajectories", options.record_test_episodes.len(), |r| {
         &r.test_trajectories
     })?;
-    let mut starts = vec![f64::NAN; results.len() * options.test_episodes * task_dim];
-    for (i, r) in results.iter().enumerate() {
-        let at = i * options.test_episodes * task_dim;
-        let len = r.test_starts.len().min(options.test_episodes * task_dim);
-        starts[at..at + len].copy_from_slice(&r.test_starts[..len]);
-    }
-    out.set_item(
-        "test_starts",
-        PyArray1::from_vec(py, starts).reshape([results.len(), options.test_episodes, task_dim])?,
-    )?;
+    let per_episode = |name: &str, n: usize, width: usize, of: fn(&TrialResult) -> &[f64]| -> PyResult<()> {
+        let mut rows = vec![f64::NAN; results.len() * n * width];
+        for (i, r) in results.iter().enumerate() {
+            let len = of(r).len().min(n * width);
+            rows[i * n * width..i * n * width + len].copy_from_slice(&of(r)[..len]);
+        }
+        out.set_item(name, PyArray1::from_vec(py, rows).reshape([results.len(), n, width])?)
+    };
+    per_episode("test_starts", options.test_episodes, task_dim, |r| &r.test_starts)?;
+    per_episode("mean_states", options.episodes, template.grid().dim(), |r| {
+        &r.mean_states
+    })?;
     out.set_item(
         "finished",
         PyArray1::from_vec(py, results.iter().map(|r| r.finished).collect::<Vec<bool>>()),

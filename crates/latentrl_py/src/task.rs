@@ -21,7 +21,11 @@ use crate::projection::EncoderObject;
 use crate::runner::{RunArgs, check_recording, gp_map, invalid, latent_args, pack_results, run_with_polling};
 
 /// `classify`'s result: one code per posture and the effector positions.
-type CodesAndEffectors<'py> = (Bound<'py, PyArray1<i8>>, Bound<'py, PyArray2<f64>>);
+type CodesEffectorsTargets<'py> = (
+    Bound<'py, PyArray1<i8>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+);
 
 /// A checked task: its configuration and its robot (docs/tasks.md).
 #[pyclass(name = "Task", module = "latentrl._native", frozen)]
@@ -208,12 +212,14 @@ impl PyTaskPlant {
     }
 
     /// For each posture of `postures` (M, D) at rest: the code of the rule it breaks (0: none;
-    /// 1 obstacle, 2 outside the joint limits, 3 drop, 4 fall) and the effector positions (M, 3E).
+    /// 1 obstacle, 2 outside the joint limits, 3 drop, 4 fall), the effector positions (M, 3E)
+    /// and the target's (M, 3E) in the world (they differ by posture if `target.relative_to`
+    /// is set).
     fn classify<'py>(
         &mut self,
         py: Python<'py>,
         postures: PyReadonlyArray2<'py, f64>,
-    ) -> PyResult<CodesAndEffectors<'py>> {
+    ) -> PyResult<CodesEffectorsTargets<'py>> {
         guard(|| {
             let postures = points("postures", &postures)?;
             let d = self.inner.posture_dim();
@@ -225,19 +231,25 @@ impl PyTaskPlant {
                 )));
             }
             let inner = &mut self.inner;
-            let (codes, effectors) = py.detach(|| {
+            let (codes, effectors, targets) = py.detach(|| {
                 let mut codes = Vec::with_capacity(postures.ncols());
-                let mut effectors = Vec::new();
+                let (mut effectors, mut targets) = (Vec::new(), Vec::new());
                 for q in postures.column_iter() {
                     let q: Vec<f64> = q.iter().copied().collect();
                     codes.push(inner.reset(&q).map_or(0, |e| e.code() as i8));
                     effectors.extend_from_slice(inner.effectors());
+                    targets.extend(inner.target_position());
                 }
-                (codes, effectors)
+                (codes, effectors, targets)
             });
             let e = self.inner.effectors().len();
             let effectors = DMatrix::from_vec(e, codes.len(), effectors);
-            Ok((PyArray1::from_vec(py, codes), to_points(py, effectors)?))
+            let targets = DMatrix::from_vec(e, codes.len(), targets);
+            Ok((
+                PyArray1::from_vec(py, codes),
+                to_points(py, effectors)?,
+                to_points(py, targets)?,
+            ))
         })
     }
 
@@ -252,6 +264,13 @@ impl PyTaskPlant {
     /// The effector positions (3E,): x, y, z per effector.
     fn effectors<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_vec(py, self.inner.effectors().to_vec())
+    }
+
+    /// The target h* in the world now (E, 3): `target.position`, moved with
+    /// `target.relative_to`'s origin if set.
+    fn target_position<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let e = self.inner.effectors().len() / 3;
+        to_points(py, DMatrix::from_vec(3, e, self.inner.target_position()))
     }
 
     /// The reached joint positions (D,).

@@ -43,28 +43,35 @@ fn a_stance_stands_every_posture_on_the_same_spot() {
 #[test]
 fn a_relative_target_moves_with_the_feet() {
     let demos = common::lift_demos();
-    let world = lift(|_| {}).unwrap();
-    // h* measured from the left sole: demo 6's hands minus its sole, standing where the start
-    // rule puts demo 6 (where the shipped world target was taken).
-    let mut p = TaskPlant::new(world.clone(), Some(&demos)).unwrap();
+    let shipped = lift(|_| {}).unwrap();
+    assert_eq!(shipped.config().target.relative_to.as_deref(), Some("l_foot"));
+    // The shipped h* is demo 6's hands measured from its left sole; `target_position` is it in
+    // the world, the sole's origin plus `target.position`.
+    let mut p = TaskPlant::new(shipped.clone(), Some(&demos)).unwrap();
     p.reset(&demos[6]);
-    assert!(p.reached_target(), "the shipped world h* is demo 6's hands");
+    assert!(p.reached_target(), "the shipped h* is demo 6's hands");
     let sole = p.world().link_pose("l_foot").unwrap().translation.vector;
-    let relative_target: Vec<[f64; 3]> = world
-        .config()
-        .target
-        .position
-        .iter()
-        .map(|t| [t[0] - sole.x, t[1] - sole.y, t[2] - sole.z])
+    let world_target: Vec<[f64; 3]> = p
+        .target_position()
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
         .collect();
+    for (t, w) in shipped.config().target.position.iter().zip(&world_target) {
+        for k in 0..3 {
+            assert!(
+                (w[k] - t[k] - sole[k]).abs() < 1e-12,
+                "world target {w:?} = {t:?} + sole {sole:?}"
+            );
+        }
+    }
     for (stance, moved) in [(None, false), (Some([sole.x + 0.04, sole.y]), true)] {
-        let relative = lift(|c| {
+        let relative = lift(|c| c.fall.as_mut().unwrap().stance = stance).unwrap();
+        let absolute = lift(|c| {
             c.fall.as_mut().unwrap().stance = stance;
-            c.target.relative_to = Some("l_foot".into());
-            c.target.position = relative_target.clone();
+            c.target.relative_to = None;
+            c.target.position = world_target.clone();
         })
         .unwrap();
-        let absolute = lift(|c| c.fall.as_mut().unwrap().stance = stance).unwrap();
         let mut rel = TaskPlant::new(relative, Some(&demos)).unwrap();
         let mut abs = TaskPlant::new(absolute, Some(&demos)).unwrap();
         rel.reset(&demos[6]);
@@ -74,6 +81,11 @@ fn a_relative_target_moves_with_the_feet() {
             "relative target reached with the feet at {stance:?}"
         );
         assert_eq!(abs.reached_target(), !moved, "world target with the feet at {stance:?}");
+        let shift = rel.target_position()[0] - world_target[0][0];
+        assert!(
+            (shift - if moved { 0.04 } else { 0.0 }).abs() < 1e-6,
+            "h* moved {shift} m with the feet"
+        );
         if !moved {
             assert!((rel.reward() - abs.reward()).abs() < 1e-9, "same feet, same reward");
         }

@@ -65,12 +65,11 @@ def _latent_panel(
     reach = task.to_dict()["target"]["reach_radius"]
 
     def regions(ax: Axes, g0: NDArray[np.float64], g1: NDArray[np.float64], postures: NDArray[np.float64]) -> None:
-        codes, effectors = plant.classify(np.clip(postures, task.lower, task.upper))
+        codes, effectors, targets = plant.classify(np.clip(postures, task.lower, task.upper))
         codes = codes.reshape(g0.shape)
         ax.contourf(g0, g1, (codes == 1).astype(float), levels=[0.5, 1.5], colors="k")
         ax.contour(g0, g1, (codes == 3).astype(float), levels=[0.5], colors="r", linewidths=1)
-        target = np.asarray(task.to_dict()["target"]["position"]).ravel()
-        rms = np.sqrt(((effectors - target) ** 2).sum(axis=1) / 2).reshape(g0.shape)
+        rms = np.sqrt(((effectors - targets) ** 2).sum(axis=1) / 2).reshape(g0.shape)
         ax.contour(g0, g1, rms, levels=[reach], colors="w", linestyles="--", linewidths=1)
 
     latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, learner=learner, regions=regions, grid=grid)

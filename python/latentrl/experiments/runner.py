@@ -55,12 +55,14 @@ PER_TRIAL = {
     "trajectories": "_paths",
     "test_trajectories": "_test_paths",
     "test_start_hands": "_test_start_hands",
+    "mean_states": "_mean_state",
     "weights": "_weights",
 }
 """Further per-trial arrays of the native call (frozen test episodes (trials, K), recorded
-paths, the effectors' (x, y, z) at the start of every test episode (trials, K, 3E), final
-weights) and their suffix in returns.npz; stored when the call returns them with a non-empty
-per-trial part."""
+paths, the effectors' (x, y, z) at the start of every test episode (trials, K, 3E), the
+learner's mean state over every training episode (trials, episodes, d), final weights) and
+their suffix in returns.npz; stored when the call returns them with a non-empty per-trial
+part."""
 
 
 def array_key(learner: str, what: str) -> str:

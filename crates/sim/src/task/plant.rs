@@ -253,18 +253,32 @@ impl TaskPlant {
         }
     }
 
+    /// Where h and h* are measured from now: `target.relative_to`'s origin, or the world's.
+    fn target_origin_position(&self) -> [f64; 3] {
+        self.target_origin
+            .as_ref()
+            .map_or([0.0; 3], |f| self.world.frame_position(f))
+    }
+
     /// ‖h − h*‖², h measured from `target.relative_to`'s origin if set.
     fn squared_distance(&self) -> f64 {
-        let origin = self
-            .target_origin
-            .as_ref()
-            .map_or([0.0; 3], |f| self.world.frame_position(f));
+        let origin = self.target_origin_position();
         self.effectors
             .chunks_exact(3)
             .zip(self.target.chunks_exact(3))
             .flat_map(|(h, t)| (0..3).map(move |k| h[k] - origin[k] - t[k]))
             .map(|e| e * e)
             .sum()
+    }
+
+    /// The target h* in the world now, (x, y, z) per effector: `target.position`, moved with
+    /// `target.relative_to`'s origin if set (what figures and videos draw).
+    pub fn target_position(&self) -> Vec<f64> {
+        let origin = self.target_origin_position();
+        self.target
+            .chunks_exact(3)
+            .flat_map(|t| (0..3).map(move |k| t[k] + origin[k]))
+            .collect()
     }
 
     /// `R(h) = exp(−θ ‖(h − h*)/ℓ‖²)` (paper Eq. 12 with a length unit ℓ) now.
