@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from latentrl.experiments.table1 import PAPER, Table1Preset, run_table1
@@ -97,13 +98,18 @@ def test_workers_do_not_change_results():
         ("constraint_test", "angle", "constraint_test"),
         ("latent_margin", -0.1, "latent_margin"),
         ("tolerance", 0.0, "tolerance"),
-        ("encode_method", "nearest", "encode_method"),
+        ("encoder", "nearest", "encoder: expected one of gp, projection, back_constrained"),
         ("variant_margins", (0.0, float("nan")), r"variant_margins\[1\]"),
     ],
 )
 def test_bad_preset(field, value, message):
     with pytest.raises(ValueError, match=message):
         run_table1(dataclasses.replace(TINY, **{field: value}), progress=False)
+
+
+def test_the_back_constrained_encoder_takes_no_latent_prior():
+    with pytest.raises(ValueError, match="encoder: 'back_constrained' takes no gplvm_latent_prior"):
+        dataclasses.replace(TINY, encoder="back_constrained", gplvm_latent_prior=True).validate()
 
 
 def test_example_script_runs(tmp_path):
@@ -116,3 +122,14 @@ def test_example_script_runs(tmp_path):
         check=True,
     )
     assert "Table I" in done.stdout and (tmp_path / "table1.json").exists()
+
+
+def test_the_encoder_is_a_flag_of_table1(tiny_run):
+    """`encoder="back_constrained"` fits Z = g(X) and reconstructs through it: finite errors,
+    not the gp encoder's; recorded in the preset."""
+    gp, _ = tiny_run
+    tiny = dataclasses.replace(TINY, trials=1, variants=False, encoder="back_constrained")
+    bc = run_table1(tiny, progress=False)
+    joint = bc["trials"][0]["fits"]["main"]["joint"]["GPLVM"]
+    assert np.isfinite(joint["recon"]) and joint["recon"] != gp["trials"][0]["fits"]["main"]["joint"]["GPLVM"]["recon"]
+    assert bc["preset"]["encoder"] == "back_constrained"

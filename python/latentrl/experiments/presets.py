@@ -29,6 +29,12 @@ from latentrl._validation import int_at_least
 RL_ENCODERS = ("gp", "projection", "back_constrained")
 
 
+def check_encoder(encoder: str) -> None:
+    """ValueError naming the `encoder` field unless it is one of `RL_ENCODERS`."""
+    if encoder not in RL_ENCODERS:
+        raise ValueError(f"encoder: expected one of {', '.join(RL_ENCODERS)}, got {encoder!r}")
+
+
 @cache
 def field_docs(preset_cls: type) -> dict[str, str]:
     """The attribute docstrings of a dataclass and its dataclass bases (the string literal under
@@ -118,8 +124,7 @@ class LatentRun:
         check_ints(self, ("trials", "episodes", "gplvm_max_iter"))
         check_ints(self, ("seed", "test_episodes"), minimum=0)
         check_floats(self, ("latent_margin",), positive=False)
-        if self.encoder not in RL_ENCODERS:
-            raise ValueError(f"encoder: expected one of {', '.join(RL_ENCODERS)}, got {self.encoder!r}")
+        check_encoder(self.encoder)
         records = self.trials * (self.episodes + self.test_episodes)
         if records > _native.MAX_EPISODES:
             raise ValueError(
