@@ -63,6 +63,8 @@ bench: build ## criterion benches, the NumPy loop, GPy, MuJoCo and Pinocchio com
 	benches/.venv-bench/bin/python benches/bench_gp.py
 	benches/.venv-bench/bin/python benches/bench_sim.py
 	benches/.venv-bench/bin/python benches/bench_urdf.py
+	benches/.venv-bench/bin/python benches/bench_accuracy.py
+	$(PY) benches/ratio_table.py
 
 figures: build ## the README's two GIFs: quick Exp 2 and Exp 3 runs into results/, then latentrl replay of a frozen test episode of each
 	$(PY) -m latentrl run exp2 --quick --no-progress --out results/exp2-quick
