@@ -206,20 +206,19 @@ impl TaskPlant {
         if let Some(pristine) = &self.pristine {
             self.world.restore(pristine);
         }
-        match (&mut self.fall, self.task.config().floor.as_ref()) {
-            (Some(fall), Some(floor)) => {
-                let stance = self.task.config().fall.as_ref().and_then(|f| f.stance);
+        let config = self.task.config();
+        match (&mut self.fall, config.floor.as_ref(), config.fall.as_ref()) {
+            (Some(fall), Some(floor), Some(rule)) => {
                 reset_on_ground(
                     &mut self.world,
                     posture,
                     &fall.soles[0],
                     floor.height,
                     CLEARANCE,
-                    stance,
+                    rule.stance,
                 )?;
                 let base = self.world.base_pose().translation.z;
-                let fraction = self.task.config().fall.as_ref().map_or(0.5, |f| f.base_height_fraction);
-                fall.min_base_height = floor.height + fraction * (base - floor.height);
+                fall.min_base_height = floor.height + rule.base_height_fraction * (base - floor.height);
             }
             _ => self.world.reset(posture)?,
         }
