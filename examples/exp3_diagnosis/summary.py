@@ -21,12 +21,13 @@ out = Path(sys.argv[1])
 meta = json.loads((out / "results.json").read_text())
 _, preset = saved_run(out)
 with np.load(out / "returns.npz") as npz:
-    a = {k: npz[k] for k in npz.files}
+    done = npz["latent_test_end"][:, -1] >= 0  # finished trials only (a run may be unfinished)
+    a = {k: npz[k][done] for k in npz.files if npz[k].ndim and npz[k].shape[0] == len(done)}
 ends, reached = a["latent_test_end"], a["latent_test_reached"]
 ok = (ends == 0) & reached
 floor = a["latent_test_start_hands"][..., [2, 5]].max(-1) <= exp3.FLOOR_LEVEL
 names = end_reasons()
-print(f"{out}: {ok.shape[0]} trials, wall {meta['wall_time_s'] / 60:.1f} min")
+print(f"{out}: {ok.shape[0]} of {len(done)} trials finished, wall {meta['wall_time_s'] / 60:.1f} min")
 print(f"frozen tests: {ok.sum()} of {ok.size} succeed ({100 * ok.mean():.1f} %); per trial "
       f"{np.round(100 * ok.mean(1), 1).tolist()} %")
 print(f"floor-level starts: {floor.sum()}, succeed {ok[floor].sum()} ({100 * ok[floor].mean():.1f} %); per trial "
