@@ -23,8 +23,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
-
-
 from typing import Any
 
 import numpy as np
@@ -40,7 +38,7 @@ from latentrl.task import Task
 
 FLOOR_LEVEL = 0.10
 """Hands at most this high above the floor (m) start a lift "from the floor" (issue #18's
-frozen-test goal counts these starts)."""
+frozen-test goal counts these starts; `FLOOR_TESTS` draws starts strictly below it)."""
 
 FLOOR_TESTS = {"waypoint.axis": "z", "waypoint.below": FLOOR_LEVEL, "waypoint.above": FLOOR_LEVEL,
                "episode.test_start": "below_waypoint"}
@@ -65,7 +63,7 @@ class Exp3Preset(LatentRun):
     test_episodes: int = 250
     """Frozen test episodes per trial after training (no TD updates; ours: 250, so that the
     ≈ 6 % of uniform starts with the hands at floor level number ≥ 40 over 4 trials; Fig. 7d
-    and 8 draw the first ten)."""
+    and 8 draw 10 more from floor-level starts, `floor_level_tests`)."""
     curve_window: int = 500
     """Running-mean window of Fig. 7e (at most episodes // 5 for short runs)."""
     encoder: str = "back_constrained"
