@@ -21,6 +21,6 @@ pub use fall::{FallCriteria, FallStatus};
 pub use kinematics::{ArmsPose, PlanarArms};
 pub use pd::PdGains;
 pub use shapes::{Contact, Obstacle, ObstacleId, ObstacleShape};
-pub use task::{Task, TaskConfig, TaskPlant};
+pub use task::{RuleCheck, Task, TaskConfig, TaskPlant};
 pub use urdf::{JointInfo, JointKind, MAX_URDF_DEPTH, MAX_URDF_LINKS, MimicInfo, RootMode, UrdfModel};
 pub use world::{Frame, PhysicsConfig, ServoConfig, World, WorldConfig};

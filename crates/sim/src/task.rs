@@ -17,7 +17,7 @@ mod config;
 mod plant;
 pub use config::{
     Axis, ConstraintConfig, ConstraintKind, EpisodeConfig, FallConfig, FloorConfig, ObstacleConfig, ObstacleTest,
-    StartRule, TargetConfig, TaskConfig, TestStart, WaypointConfig,
+    RuleCheck, StartRule, TargetConfig, TaskConfig, TestStart, WaypointConfig,
 };
 pub use plant::TaskPlant;
 

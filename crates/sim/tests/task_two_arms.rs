@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize};
 use latent_core::trials::{LatentSpace, TrialOptions, TrialResult, run_latent_trials};
 use latent_core::{EndReason, GpMap, LearnerConfig, Plant, SeKernel, StartMode};
 use nalgebra::DMatrix;
-use sim::{PlanarArms, Task, TaskPlant};
+use sim::{PlanarArms, RuleCheck, Task, TaskPlant};
 
 /// The posture (elbows outward) with the left hand at `(x, y)` and the right hand 0.1 m to its right.
 fn holding(x: f64, y: f64) -> [f64; 4] {
@@ -289,4 +289,26 @@ fn trials_run_test_episodes_from_below_the_wall_and_repeat_bitwise() {
             assert_eq!(r.tests[e].passed, above);
         }
     }
+}
+
+/// One RL step that carries both hands through the right wall (y 0.30–0.37) and beyond it.
+fn jump_the_wall(check: RuleCheck) -> (Option<EndReason>, [f64; 4]) {
+    let mut config = common::task("two_arms").config().clone();
+    config.episode.check_rules = check;
+    let task = Task::from_config(config, std::path::Path::new(common::TASKS), "two_arms.toml").unwrap();
+    let mut p = TaskPlant::new(std::sync::Arc::new(task), None).unwrap();
+    assert_eq!(p.reset(&holding(0.0, 0.26)), None);
+    let mut reached = [0.0; 4];
+    let out = p.step(&holding(0.0, 0.41), &mut reached);
+    (out.end, hands(&p))
+}
+
+#[test]
+fn a_wall_crossed_within_one_rl_step_ends_only_when_every_physics_step_is_checked() {
+    let (end, h) = jump_the_wall(RuleCheck::RlStep);
+    assert!(h[1] > 0.37, "the hands end beyond the wall: {h:?}");
+    assert_eq!(end, None, "once per RL step: the end state is clear");
+    let (end, h2) = jump_the_wall(RuleCheck::PhysicsStep);
+    assert_eq!(end, Some(EndReason::Obstacle), "the wall was crossed in between");
+    assert_eq!(h, h2, "the check does not change the motion");
 }

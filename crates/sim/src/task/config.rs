@@ -82,6 +82,17 @@ choice! {
     }
 }
 
+choice! {
+    /// When a step tests the rules that end an episode (obstacles, falls, constraints).
+    pub enum RuleCheck {
+        /// Once, after the RL step's last physics step (SPEC: the reached state).
+        RlStep = "rl_step",
+        /// After every physics step of the RL step: a touch in between ends it too (the
+        /// RL step still runs all its physics steps).
+        PhysicsStep = "physics_step",
+    }
+}
+
 params! {
     /// A floor under a floating robot.
     pub struct FloorConfig {
@@ -330,6 +341,9 @@ params! {
         max_start_draws: usize = 1000 => Rule::count(1, 1_000_000_000),
         /// Which admissible starts may start a frozen test episode: "any" or "below_waypoint".
         test_start: TestStart = TestStart::Any => Rule::Any,
+        /// When a step tests the end rules: "rl_step" (once, at its end) or "physics_step"
+        /// (after each of its physics steps; ours, issue #18).
+        check_rules: RuleCheck = RuleCheck::RlStep => Rule::Any,
     }
 }
 

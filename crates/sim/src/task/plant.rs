@@ -4,7 +4,8 @@
 //! world advances one RL step (`physics.substeps × physics.dt`), the joint positions are read
 //! back (the **reached** posture) and the effector positions from their link frames. Then, on
 //! the reached state, in this order: an obstacle touched (code 1), a fall (code 4), a
-//! constraint broken (code 3) end the episode with `reward + penalty`; the reward is
+//! constraint broken (code 3) end the episode with `reward + penalty` (with
+//! `episode.check_rules = "physics_step"`, also when one held after any physics step of it); the reward is
 //! `exp(−θ ‖(h − h*)/ℓ‖²)` over the effector positions h. The same rules refuse a start at
 //! [`Plant::reset`], with a posture outside the joint limits (code 2) and, with a fall rule,
 //! a centre of mass outside the support (`fall.min_start_margin`) as well.
@@ -21,7 +22,7 @@ use latent_core::{EndReason, Plant, StepOutcome};
 use nalgebra::{Point3, Vector3};
 use rand::{Rng, RngExt};
 
-use super::{ConstraintKind, ObstacleTest, Task, TestStart};
+use super::{ConstraintKind, ObstacleTest, RuleCheck, Task, TestStart};
 use crate::error::{Result, SimError};
 use crate::fall::{FallCriteria, reset_on_ground, support_margin};
 use crate::shapes::{Obstacle, ObstacleShape};
@@ -462,14 +463,26 @@ impl Plant for TaskPlant {
                 end: Some(EndReason::BoxExit),
             };
         }
-        self.world.step_rl();
+        let mut end = None;
+        match self.task.config().episode.check_rules {
+            RuleCheck::RlStep => self.world.step_rl(),
+            RuleCheck::PhysicsStep => {
+                for _ in 0..self.task.config().physics.substeps {
+                    self.world.step(1);
+                    if end.is_none() {
+                        self.read_effectors();
+                        end = self.violation();
+                    }
+                }
+            }
+        }
         self.world.joint_positions_into(reached);
         self.read_effectors();
         if let Some(w) = &self.task.config().waypoint {
             let above = w.above;
             self.went_above |= self.all_effectors(|v| v > above);
         }
-        let end = self.violation();
+        let end = end.or_else(|| self.violation());
         let reward = self.reward() + if end.is_some() { penalty } else { 0.0 };
         StepOutcome { reward, end }
     }
