@@ -51,7 +51,7 @@ def test_help_documents_every_preset_flag():
     exp2 = " ".join(latentrl("run", "exp2", "--help").stdout.split())
     # Task keys: the native doc, kind, rule and default of each.
     assert "--learner.gamma FLOAT Discount γ; below 1" in exp2 and "must lie in [0, 1); default: 0.99)" in exp2
-    assert "--physics.dt" in exp2 and "default: 0.004166666666666667" in exp2
+    assert "--physics.dt" in exp2 and "default: 0.008333333333333333" in exp2
 
 
 @pytest.mark.parametrize("experiment", ["table1", "exp1", "exp2", "exp3"])

@@ -50,7 +50,7 @@ def test_shipped_tasks_load_with_their_robots():
          r'effectors\[1\]: unknown link "right_hnd"; links are: .*left_hand'),
         (('position = [[-0.05, 0.47, 0.0], [0.05, 0.47, 0.0]]', "position = [[-0.05, 0.47, 0.0]]"),
          r"target.position needs one \[x, y, z\] row per effector \(2 effectors: left_hand, right_hand\), got 1 rows"),
-        (("dt = 0.004166666666666667", "dt = 1e10"), r"physics.dt must lie in \(0, 0.05\], got 10000000000"),
+        (("dt = 0.008333333333333333", "dt = 1e10"), r"physics.dt must lie in \(0, 0.05\], got 10000000000"),
         (('kind = "offset"', 'kind = "glue"'), r"constraints\[0\].kind \(line \d+\): unknown variant `glue`, expected one of"),
         (('links = ["left_hand", "right_hand"]\noffset', 'link = "left_hand"\noffset'),
          r"constraints\[0\].links is required for kind = \"offset\""),
