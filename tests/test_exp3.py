@@ -50,7 +50,7 @@ def test_runs_record_postures_and_echo_the_task(fitted):
         poses = plant.pose_links(row[base], row[rows["joints"]])
         np.testing.assert_allclose(poses[task.link_names.index("l_hand")][:3], row[:3], rtol=0, atol=1e-6)
     config = a["task"]
-    assert config["physics"]["solver_iterations"] == 1 and config["physics"]["pgs_iterations"] == 4
+    assert config["physics"]["solver_iterations"] == 2 and config["physics"]["pgs_iterations"] == 4
     assert config["servo"]["kp"] == 8.0 and config["servo"]["max_force"] == 1.2 and config["episode"]["max_steps"] == 5
 
 
