@@ -59,9 +59,9 @@ def reference_of(task: Task) -> Task:
 
 
 def track(task: Task, demos: NDArray[np.float64], plan: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """The task's plant at rest at `plan`'s first posture, then following `plan`: the effectors
-    and the base position (steps + 1, effectors + 1, 3) and the joint positions (steps + 1, D) after the
-    reset and after every RL step. The task's episode rules are not applied (the plant keeps
+    """The task's plant at rest at `plan`'s first posture, then following `plan`: after the reset
+    and after every RL step, the effectors and the base position (steps + 1, effectors + 1, 3)
+    and the joint positions (steps + 1, D). The task's end rules do not stop it (the plant keeps
     stepping)."""
     plant = task.plant(demos)
     end = plant.reset(np.ascontiguousarray(plan[0]))
