@@ -5,9 +5,9 @@
 //! back (the **reached** posture) and the effector positions from their link frames. Then, on
 //! the reached state, in this order: an obstacle touched (code 1), a fall (code 4), a
 //! constraint broken (code 3) end the episode with `reward + penalty` (with
-//! `episode.check_rules = "physics_step"`, also when one held after any physics step of it); the reward is
-//! `exp(−θ ‖(h − h*)/ℓ‖²)` over the effector positions h. The same rules refuse a start at
-//! [`Plant::reset`], with a posture outside the joint limits (code 2) and, with a fall rule,
+//! `episode.check_rules = "physics_step"`, also when one held after any physics step of it);
+//! the reward is `exp(−θ ‖(h − h*)/ℓ‖²)` over the effector positions h. The same rules
+//! refuse a start at [`Plant::reset`], with a posture outside the joint limits (code 2) and, with a fall rule,
 //! a centre of mass outside the support (`fall.min_start_margin`) as well.
 //!
 //! Resets: a fixed-root robot is reset in place (every coordinate set exactly); a floating
@@ -467,13 +467,15 @@ impl Plant for TaskPlant {
         match self.task.config().episode.check_rules {
             RuleCheck::RlStep => self.world.step_rl(),
             RuleCheck::PhysicsStep => {
-                for _ in 0..self.task.config().physics.substeps {
+                // Every physics step but the last; the last is checked below, as in RlStep.
+                for _ in 1..self.task.config().physics.substeps {
                     self.world.step(1);
                     if end.is_none() {
                         self.read_effectors();
                         end = self.violation();
                     }
                 }
+                self.world.step(1);
             }
         }
         self.world.joint_positions_into(reached);
