@@ -9,27 +9,28 @@ from latentrl import Task
 from latentrl.envs import shipped_demos
 from latentrl.physics_check import REFERENCE, demo_path, physics_error, reference_of
 
-TOLERANCE_M = {"two_arms": 1e-3, "humanoid_lift": 1e-2}
-"""docs/performance.md: the arms' hands within 1 mm, the humanoid's hands and base within 10 mm."""
-
 PATHS = {"two_arms": None, "humanoid_lift": (6, 5, 6)}
 """Demos in turn: the arms' default (5 spread over the file), the humanoid's squat up and down
 (the accuracy bench's moves)."""
 
 
-@pytest.mark.parametrize("name", sorted(TOLERANCE_M))
+@pytest.mark.parametrize("name", sorted(PATHS))
 def test_shipped_physics_hold_their_tolerance(name):
     task = Task.shipped(name)
     error = physics_error(task, shipped_demos(name), PATHS[name])
     assert error["simulated_s"] >= 2.5
-    assert 0 < error["position_m"] <= TOLERANCE_M[name], error
+    assert 0 < error["position_m"] <= error["tolerance_m"], error  # the task file's physics.tolerance
+    assert error["within"] is True
 
 
 def test_a_coarse_setting_misses_the_arms_tolerance():
     coarse = Task.shipped("two_arms").replace({"physics.dt": 1 / 120, "physics.substeps": 6,
                                                "physics.solver_iterations": 1, "physics.pgs_iterations": 1})
     error = physics_error(coarse, shipped_demos("two_arms"), (0, 60))
-    assert error["position_m"] > TOLERANCE_M["two_arms"], error
+    assert error["position_m"] > error["tolerance_m"] == 1e-3, error
+    assert error["within"] is False
+    undeclared = physics_error(coarse.replace({"physics.tolerance": None}), shipped_demos("two_arms"), (0, 60))
+    assert undeclared["tolerance_m"] is None and undeclared["within"] is None
 
 
 def test_the_path_runs_through_the_demos_at_the_rl_step():

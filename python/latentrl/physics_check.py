@@ -4,7 +4,7 @@ the task's settings and at `REFERENCE`, and the largest distance of an effector 
 floating base) between the two runs is the error. Run it on your own task before a long run:
 
     from latentrl.physics_check import physics_error
-    physics_error(task, demos)   # {"position_m": …, "joint_rad": …, "settings": …, "reference": …}
+    physics_error(task, demos)   # {"position_m": …, "within": …, "joint_rad": …, "settings": …, …}
 
 rapier's path depends on dt / solver iterations, not on the two apart (docs/performance.md), so
 the reference refines both: dt 1/16000 s, 4 solver iterations × 4 PGS passes.
@@ -85,15 +85,19 @@ def track(task: Task, demos: NDArray[np.float64], plan: NDArray[np.float64]) -> 
 def physics_error(task: Task, demos: NDArray[np.float64], order: Sequence[int] | None = None) -> dict[str, Any]:
     """The largest effector (or base) distance and joint-angle difference between the task's
     physics and `REFERENCE` along `demo_path(task, demos, order)` (default: at most 5 demos,
-    evenly spaced over the file, in turn); with the settings compared."""
+    evenly spaced over the file, in turn); with the settings compared, the task's declared
+    `physics.tolerance` and whether the distance is within it (None if none is declared)."""
     if order is None:
         order = np.linspace(0, len(demos) - 1, min(len(demos), 5)).round().astype(int).tolist()
     plan = demo_path(task, demos, order)
     p, q = track(task, demos, plan)
     p_ref, q_ref = track(reference_of(task), demos, plan)
     distance = np.linalg.norm(p - p_ref, axis=-1)
+    tolerance = task.to_dict()["physics"]["tolerance"]
     return {
         "position_m": float(distance.max()),
+        "tolerance_m": tolerance,
+        "within": None if tolerance is None else bool(distance.max() <= tolerance),
         "worst_t_s": float(task.rl_dt * distance.max(axis=1).argmax()),
         "joint_rad": float(np.abs(q - q_ref).max()),
         "simulated_s": float(task.rl_dt * len(plan)),

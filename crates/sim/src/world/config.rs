@@ -34,6 +34,10 @@ params! {
         ignore_collisions: Vec<[String; 2]> = Vec::new() => Rule::Any,
         /// Shapes closer than this (m) touch, for the obstacle and floor queries.
         contact_margin: f64 = 1e-3 => Rule::closed(0.0, 1.0),
+        /// The largest effector (and floating-base) distance (m) from a fine-step reference
+        /// that these settings were chosen for; `latentrl.physics_check` tests it. None: not
+        /// declared. The world does not use it.
+        tolerance: Option<f64> = None => Rule::Positive,
     }
 }
 
