@@ -57,3 +57,10 @@ def test_bad_demos_or_rows_are_named():
         physics_error(task, np.zeros((3, 5)))
     with pytest.raises(ValueError, match=r"order: expected demo rows in 0\.\.2"):
         physics_error(task, shipped_demos("two_arms")[:3], (0, 3))
+
+
+def test_a_path_that_cannot_start_names_its_demo_and_the_rule():
+    demos = shipped_demos("two_arms")
+    apart = np.vstack([demos[:2], [[3.0, 0.0, 0.0, 0.0]]])  # the hands far apart: the object drops
+    with pytest.raises(ValueError, match=r"demo row 2: .* cannot start an episode of two_arms: it breaks the drop rule"):
+        physics_error(Task.shipped("two_arms"), apart, (2, 0))

@@ -5,7 +5,7 @@
 Runs each trial's learnt greedy policy (no learning) from uniform latent starts and classifies,
 at rest (`TaskPlant.classify`), the posture every chosen latent target decodes to. Counts, for
 the episodes that end on the block, how many had a target touching the block at rest in their
-last steps, and, for the episodes that lift to h* cleanly, how many passed through such a target
+last steps, and, for the episodes that run to the step limit, how many passed through such a target
 (the good paths a filter would cut).
 """
 import sys
@@ -33,7 +33,7 @@ plant, judge = task.plant(fitted.demos), task.plant(fitted.demos)
 
 rng = np.random.default_rng(12345)
 totals = {"episodes": 0, "obstacle": 0, "obstacle_seen_last": 0, "obstacle_seen_any": 0,
-          "success": 0, "success_touching_target": 0, "targets": 0, "targets_touching": 0}
+          "timeout": 0, "timeout_touching_target": 0, "targets": 0, "targets_touching": 0}
 for t in range(trials):
     policy = _native.LatentPolicy(learner, list(low), list(high), weights[t], fitted.model.decoder_,
                                   fitted.model.loop_encoder_)
@@ -56,6 +56,6 @@ for t in range(trials):
             totals["obstacle_seen_last"] += bool(touching[-LAST:].any())
             totals["obstacle_seen_any"] += bool(touching.any())
         elif end is None:
-            totals["success"] += 1
-            totals["success_touching_target"] += bool(touching.any())
+            totals["timeout"] += 1
+            totals["timeout_touching_target"] += bool(touching.any())
 print(out, f"{trials} trials × {starts} uniform starts, last {LAST} targets:", totals)

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from latentrl import _native
 from latentrl.task import Task
 
 REFERENCE = {"dt": 1 / 16000, "solver_iterations": 4, "pgs_iterations": 4}
@@ -66,7 +67,8 @@ def track(task: Task, demos: NDArray[np.float64], plan: NDArray[np.float64]) -> 
     plant = task.plant(demos)
     end = plant.reset(np.ascontiguousarray(plan[0]))
     if end is not None:
-        raise ValueError(f"the path's first posture cannot start an episode of {task.name} (end code {end})")
+        reason = _native.end_reasons()[end]
+        raise ValueError(f"the path's first posture cannot start an episode of {task.name}: it breaks the {reason} rule")
     slices = task.row_slices()
     points, joints = [], []
 
@@ -90,7 +92,10 @@ def physics_error(task: Task, demos: NDArray[np.float64], order: Sequence[int] |
     if order is None:
         order = np.linspace(0, len(demos) - 1, min(len(demos), 5)).round().astype(int).tolist()
     plan = demo_path(task, demos, order)
-    p, q = track(task, demos, plan)
+    try:
+        p, q = track(task, demos, plan)
+    except ValueError as e:
+        raise ValueError(f"demo row {order[0]}: {e}") from None
     p_ref, q_ref = track(reference_of(task), demos, plan)
     distance = np.linalg.norm(p - p_ref, axis=-1)
     tolerance = task.to_dict()["physics"]["tolerance"]
