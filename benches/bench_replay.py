@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from importlib import import_module
 from pathlib import Path
 
 import numpy as np
@@ -24,15 +23,14 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def fps(run: Path, width: int, frames: int) -> dict[str, float]:
     """Frames per second drawing `frames` frames of the run's first recorded test episode: the
-    link poses and the latent path of the stored rows, then the frames (the GPLVM refit of the
-    saved preset is done before the clock starts)."""
+    link poses and the latent path of the stored rows, then the frames (reading the run's saved
+    GPLVM included)."""
     name, preset = saved_run(run)
-    import_module(f"latentrl.experiments.{name}").fit(preset)  # cached: `recorded` reuses it
     arrays = load_arrays(run)
     rows, _ = episode_path(arrays, 0, None, 0, preset.episodes)
     rows = rows[np.linspace(0, len(rows) - 1, frames).round().astype(int)]
     start = time.perf_counter()
-    episode = recorded(name, preset, rows, np.asarray(arrays["latent_weights"])[0], name)
+    episode = recorded(name, preset, run, rows, np.asarray(arrays["latent_weights"])[0], name)
     out = render_frames(episode, size=(width, width // 2), max_frames=frames)
     seconds = time.perf_counter() - start
     return {"frames": len(out), "seconds": seconds, "frames_per_s": len(out) / seconds}

@@ -82,8 +82,8 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
     run_experiment("exp1", TINY, tmp_path / "whole", progress=False)
     calls = {"n": 0}
 
-    def interrupting_setup(preset):
-        built = exp1.setup(preset)
+    def interrupting_setup(preset, run):
+        built = exp1.setup(preset, run)
         inner = built.learners["full"]
 
         def full(**kwargs):

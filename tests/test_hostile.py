@@ -6,8 +6,10 @@ import json
 import numpy as np
 import pytest
 
-from latentrl import cli
+from latentrl import GPLVM, cli
 from latentrl._native import InvalidInputError, Sim
+from latentrl.experiments import exp1
+from latentrl.experiments.latent_runs import Fitted
 
 TINY = ["run", "exp1", "--quick", "--trials", "2", "--episodes", "5", "--plant.max-steps", "20", "--no-progress"]
 
@@ -47,6 +49,38 @@ def test_class_4_resume_refuses_another_model_fit(finished_run, capsys):
     edit(finished_run, lambda m: m["setup"]["gplvm"].update(nll=m["setup"]["gplvm"]["nll"] + 1.0))
     assert cli.main(["run", "exp1", "--resume", str(finished_run), "--no-progress"]) == 1
     assert "is not the one the saved trials used" in capsys.readouterr().err
+
+
+@pytest.fixture()
+def another_machine(monkeypatch):
+    """Refits land elsewhere, as on a CPU whose BLAS kernel differs (docs/robustness.md): the
+    GPLVM's optimiser stops after 5 iterations."""
+    fit = Fitted.of.__func__
+    monkeypatch.setattr(Fitted, "of", classmethod(lambda cls, demos, **kw: fit(cls, demos, **{**kw, "max_iter": 5})))
+
+
+def test_class_4_a_run_uses_its_saved_model_where_a_refit_differs(finished_run, another_machine, tmp_path):
+    saved = GPLVM.load(finished_run / "gplvm.npz")
+    with np.load(finished_run / "returns.npz") as npz:
+        before = {k: npz[k] for k in npz.files}
+    assert cli.main(["run", "exp1", "--resume", str(finished_run), "--no-progress"]) == 0
+    with np.load(finished_run / "returns.npz") as npz:
+        for key, value in before.items():
+            np.testing.assert_array_equal(npz[key], value, err_msg=key)
+    assert cli.main(["plot", str(finished_run), "--out", str(tmp_path / "figures")]) == 0
+    _, preset = cli.saved_run(finished_run)
+    np.testing.assert_array_equal(exp1.fit(preset, finished_run).model.Z_, saved.Z_)
+    assert not np.array_equal(exp1.fit(preset).model.Z_, saved.Z_), "the refit must differ for this test to mean anything"
+
+
+def test_class_4_a_run_without_its_model_refuses_a_refit_that_differs(finished_run, another_machine, capsys):
+    (finished_run / "gplvm.npz").unlink()
+    assert cli.main(["run", "exp1", "--resume", str(finished_run), "--no-progress"]) == 1
+    err = capsys.readouterr().err
+    assert "refitted on this machine" in err and "is not the one the saved trials used" in err, err
+    _, preset = cli.saved_run(finished_run)
+    with pytest.raises(ValueError, match="is not the one the saved trials used"):
+        exp1.fit(preset, finished_run)  # what replays and figures decode with
 
 
 def test_class_4_an_unedited_run_resumes(finished_run):

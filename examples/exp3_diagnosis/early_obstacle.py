@@ -21,7 +21,7 @@ EARLY = 10
 out = Path(sys.argv[1])
 starts = int(sys.argv[2]) if len(sys.argv) > 2 else 200
 _, preset = saved_run(out)
-fitted = exp3.fit(preset)
+fitted = exp3.fit(preset, out)
 task = exp3.task_of(preset)
 learner = task.to_dict()["learner"]
 with np.load(out / "returns.npz") as npz:

@@ -39,7 +39,7 @@ print(f"obstacle endings, last 500 training episodes: {100 * (last == 1).mean():
       f"{np.round(100 * (last == 1).mean(1), 1).tolist()}); first 500: {100 * (train_end[:, :500] == 1).mean():.1f} %")
 print(f"return, episodes 1-500 -> last 500: {returns[:, :500].mean():.1f} -> {returns[:, -500:].mean():.1f}; "
       f"reached h*: {100 * train_reached[:, :500].mean():.0f} -> {100 * train_reached[:, -500:].mean():.0f} %")
-fitted = exp3.fit(preset)
+fitted = exp3.fit(preset, out)
 style = exp3.episode_styles(a["latent_mean_state"], fitted.model.Z_)
 good = (train_end == 0) & train_reached
 for k, name in enumerate(exp3.STYLES):

@@ -337,7 +337,7 @@ def _plot(args: argparse.Namespace) -> int:
     rl = experiments()[name].rl
     assert rl is not None  # saved_run finds RL experiments only
     out = args.out or args.results
-    rl.figures(preset, arrays, out)
+    rl.figures(preset, arrays, args.results, out)
     counts = ", ".join(f"{learner} {n} of {preset.trials}" for learner, n in done.items())
     print(f"figures of {name} ({counts} trials) in {out}")
     return 0

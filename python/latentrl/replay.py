@@ -83,21 +83,21 @@ class Recorded:
     toy: dict[str, Any] | None = None
 
 
-def recorded(experiment: str, preset: Any, rows: NDArray[np.float64], weights: NDArray[np.float64],
+def recorded(experiment: str, preset: Any, run_dir: Path, rows: NDArray[np.float64], weights: NDArray[np.float64],
              title: str) -> Recorded:
-    """The episode of stored `rows` of a run of `experiment`, with the run's GPLVM refitted from
-    its saved preset (the fit is deterministic in it)."""
+    """The episode of stored `rows` of the run of `experiment` in `run_dir`, with the GPLVM saved
+    there (`latent_runs.run_fit`)."""
     from latentrl.render import Scene
 
     if experiment == "exp1":
         from latentrl.experiments import exp1
 
-        fitted = exp1.fit(preset)
+        fitted = exp1.fit(preset, run_dir)
         plant, learner = exp1.configs(preset)
         hands = np.concatenate([rows.reshape(len(rows), 2, 2), np.zeros((len(rows), 2, 1))], axis=2)
         return Recorded(title, hands, fitted.model.transform(rows), weights, fitted.low, fitted.high, fitted.model,
                         learner, toy=plant)
-    task, model, (low, high) = run_setup(experiment, preset)
+    task, model, (low, high) = run_setup(experiment, preset, run_dir)
     slices = task.row_slices()
     joints = rows[:, slices["joints"]]
     base = rows[:, np.r_[slices["base_position"], slices["base_quaternion"]]]
@@ -181,17 +181,17 @@ def write_video(frames: NDArray[np.uint8], out: Path, fps: int) -> None:
             iio.imwrite(temp, frames, fps=fps)
 
 
-def run_setup(experiment: str, preset: Any) -> tuple[Any, Any, tuple[NDArray[np.float64], NDArray[np.float64]]]:
-    """The task, the GPLVM and the latent box of a run, as it was trained (the fit is
-    deterministic in the saved preset)."""
+def run_setup(experiment: str, preset: Any, run_dir: Path) -> tuple[Any, Any, tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """The task, the GPLVM and the latent box of the run in `run_dir`, as it was trained (its
+    saved GPLVM: `latent_runs.run_fit`)."""
     if experiment == "train":
         from latentrl.experiments.presets import latent_box
         from latentrl.experiments.training import fitted
 
-        task, _, model = fitted(preset)
+        task, _, model = fitted(preset, run_dir)
         return task, model, latent_box(model.Z_, preset.latent_margin)
     module = import_module(f"latentrl.experiments.{experiment}")
-    fit = module.fit(preset)
+    fit = module.fit(preset, run_dir)
     return module.task_of(preset), fit.model, (fit.low, fit.high)
 
 
@@ -224,7 +224,7 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     weights = arrays.get("latent_weights")
     if weights is None:
         raise ValueError(f"{run_dir}: the run kept no learnt weights to draw V from")
-    drawn = recorded(experiment, preset, rows, np.asarray(weights)[trial], what)
+    drawn = recorded(experiment, preset, run_dir, rows, np.asarray(weights)[trial], what)
     done = []
     if out is not None:
         frames = render_frames(drawn, size=(width, width // 2), max_frames=max_frames)

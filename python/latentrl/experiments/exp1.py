@@ -11,13 +11,14 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from functools import partial
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from latentrl import _native
 from latentrl.datasets import bimanual_pairs
-from latentrl.experiments.latent_runs import Fitted, gplvm_info, recorded_episodes
+from latentrl.experiments.latent_runs import Fitted, gplvm_info, recorded_episodes, run_fit
 from latentrl.experiments.presets import LatentRun, check_ints
 from latentrl.experiments.runner import RunTrials, Setup
 
@@ -57,20 +58,25 @@ def configs(preset: Exp1Preset) -> tuple[dict[str, Any], dict[str, Any]]:
     return plant, learner
 
 
-def fit(preset: Exp1Preset) -> Fitted:
-    """The demonstrated hand pairs (seeded by `preset.seed`), the GPLVM and its latent box."""
-    demos = bimanual_pairs(preset.n_demos, np.random.default_rng(preset.seed))
-    return Fitted.of(demos, seed=preset.seed, max_iter=preset.gplvm_max_iter, margin=preset.latent_margin,
-                     encoder=preset.encoder)
+def fit(preset: Exp1Preset, run: Path | None = None) -> Fitted:
+    """The demonstrated hand pairs (seeded by `preset.seed`), the GPLVM and its latent box; the
+    saved ones of the run in directory `run` (`latent_runs.run_fit`)."""
+    def refit() -> Fitted:
+        demos = bimanual_pairs(preset.n_demos, np.random.default_rng(preset.seed))
+        return Fitted.of(demos, seed=preset.seed, max_iter=preset.gplvm_max_iter, margin=preset.latent_margin,
+                         encoder=preset.encoder)
+
+    return run_fit(run, preset.latent_margin, refit)
 
 
-def setup(preset: Exp1Preset) -> Setup:
-    """Demonstrations, the GPLVM and its latent box, and both learners' trial runners (the
-    latent learner's final weights are kept: `latentrl replay` draws its V)."""
+def setup(preset: Exp1Preset, run: Path | None = None) -> Setup:
+    """Demonstrations, the GPLVM and its latent box (the run's in directory `run`), and both
+    learners' trial runners (the latent learner's final weights are kept: `latentrl replay`
+    draws its V)."""
     plant, learner = configs(preset)
-    fitted = fit(preset)
+    fitted = fit(preset, run)
     model, low, high = fitted.model, fitted.low, fitted.high
-    run = partial(
+    trials = partial(
         _native.run_bimanual_trials,
         episodes=preset.episodes,
         base_seed=preset.seed,
@@ -79,9 +85,9 @@ def setup(preset: Exp1Preset) -> Setup:
         record_episodes=recorded_episodes(preset.episodes),
     )
     learners: dict[str, RunTrials] = {
-        "latent": partial(run, decoder=model.decoder_, encoder=model.loop_encoder_, latent_low=low, latent_high=high,
+        "latent": partial(trials, decoder=model.decoder_, encoder=model.loop_encoder_, latent_low=low, latent_high=high,
                           return_weights=True),
-        "full": run,
+        "full": trials,
     }
     info = {
         "gplvm": gplvm_info(model),
@@ -90,4 +96,4 @@ def setup(preset: Exp1Preset) -> Setup:
         "plant": plant,
         "learner": learner,
     }
-    return Setup(learners=learners, info=info)
+    return Setup(learners=learners, info=info, model=model)

@@ -14,8 +14,9 @@ from latentrl.experiments.latent_runs import recorded_episodes
 from latentrl.plots import hand_paths, learning_curves, save_figure
 
 
-def figures(preset: Exp1Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
-    """Fig. 4a (learning curves), 4b (hand paths during learning), 4c (after learning)."""
+def figures(preset: Exp1Preset, arrays: Mapping[str, np.ndarray], run: Path, out: Path) -> None:
+    """Fig. 4a (learning curves), 4b (hand paths during learning), 4c (after learning) of a run
+    into `out` (they need nothing of the run's directory `run` beyond `arrays`)."""
     fig, ax = plt.subplots(figsize=(6, 4))
     learning_curves(ax, {name: arrays[name] for name in ("latent", "full") if name in arrays})
     ax.set_title("Exp 1: bimanual reaching, mean ± s.d. over trials")

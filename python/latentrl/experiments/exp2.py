@@ -18,11 +18,12 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
 from latentrl.datasets import arm_postures
-from latentrl.experiments.latent_runs import Fitted, latent_setup
+from latentrl.experiments.latent_runs import Fitted, latent_setup, run_fit
 from latentrl.experiments.presets import LatentRun, check_ints
 from latentrl.experiments.runner import Setup
 from latentrl.task import Task
@@ -69,10 +70,12 @@ def task_of(preset: Exp2Preset) -> Task:
     return Task.shipped("two_arms").replace(preset.task)
 
 
-def fit(preset: Exp2Preset) -> Fitted:
-    """Demonstrations (seeded by `preset.seed`), GPLVM and latent box; cached on the fields
-    they depend on, so `setup` and `figures` (and presets that differ elsewhere) share a fit."""
-    return _fit(preset.n_demos, preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder)
+def fit(preset: Exp2Preset, run: Path | None = None) -> Fitted:
+    """Demonstrations (seeded by `preset.seed`), GPLVM and latent box; the saved ones of the
+    run in directory `run` (`latent_runs.run_fit`). Fits are cached on the fields they depend
+    on, so `setup` and `figures` (and presets that differ elsewhere) share one."""
+    return run_fit(run, preset.latent_margin, lambda: _fit(
+        preset.n_demos, preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder))
 
 
 @lru_cache(maxsize=4)
@@ -81,8 +84,9 @@ def _fit(n_demos: int, seed: int, max_iter: int, margin: float, encoder: str) ->
     return Fitted.of(demos, seed=seed, max_iter=max_iter, margin=margin, encoder=encoder)
 
 
-def setup(preset: Exp2Preset) -> Setup:
-    """The two-arms task, the GPLVM on `arm_postures(n_demos)`, its latent box and the learner."""
+def setup(preset: Exp2Preset, run: Path | None = None) -> Setup:
+    """The two-arms task, the GPLVM on `arm_postures(n_demos)` (the run's in directory `run`),
+    its latent box and the learner."""
     task = task_of(preset)
-    fitted = fit(preset)
+    fitted = fit(preset, run)
     return latent_setup(preset, task, fitted.model, (fitted.low, fitted.high), fitted.demos)

@@ -25,9 +25,9 @@ PLANAR_HANDS = [0, 1, 3, 4]
 """Columns (x_L, y_L, x_R, y_R) of a recorded row of the planar arms (effectors x, y, z each)."""
 
 
-def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
-    """Fig. 5, 6a, 6b, 6c, 6d into `out` (PNG + PDF)."""
-    fitted = fit(preset)
+def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], run: Path, out: Path) -> None:
+    """Fig. 5, 6a, 6b, 6c, 6d of the run in directory `run` into `out` (PNG + PDF)."""
+    fitted = fit(preset, run)
     task = task_of(preset)
     config = task.to_dict()
     _fig5(preset, fitted, out)

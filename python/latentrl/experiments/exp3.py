@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl.envs import shipped_demos
-from latentrl.experiments.latent_runs import Fitted, latent_setup
+from latentrl.experiments.latent_runs import Fitted, latent_setup, run_fit
 from latentrl.experiments.presets import LatentRun, check_ints
 from latentrl.experiments.runner import Setup
 from latentrl.task import Task
@@ -98,9 +98,11 @@ def task_of(preset: Exp3Preset) -> Task:
     return Task.shipped("humanoid_lift").replace(preset.task)
 
 
-def fit(preset: Exp3Preset) -> Fitted:
-    """Demos, GPLVM and latent box; cached on the fields they depend on."""
-    return _fit(preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder)
+def fit(preset: Exp3Preset, run: Path | None = None) -> Fitted:
+    """Demos, GPLVM and latent box; the saved ones of the run in directory `run`
+    (`latent_runs.run_fit`). Fits are cached on the fields they depend on."""
+    return run_fit(run, preset.latent_margin,
+                   lambda: _fit(preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder))
 
 
 @lru_cache(maxsize=4)
@@ -109,21 +111,23 @@ def _fit(seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
     return Fitted.of(demos, seed=seed, max_iter=max_iter, margin=margin, encoder=encoder)
 
 
-def setup(preset: Exp3Preset) -> Setup:
-    """The humanoid lift task, the GPLVM on the lift demos, its latent box and the learner."""
+def setup(preset: Exp3Preset, run: Path | None = None) -> Setup:
+    """The humanoid lift task, the GPLVM on the lift demos (the run's in directory `run`), its
+    latent box and the learner."""
     task = task_of(preset)
-    fitted = fit(preset)
+    fitted = fit(preset, run)
     return latent_setup(preset, task, fitted.model, (fitted.low, fitted.high), fitted.demos)
 
 
-def floor_level_tests(preset: Exp3Preset, weights: NDArray[np.float64], episodes: int = 10) -> dict[str, Any]:
+def floor_level_tests(preset: Exp3Preset, weights: NDArray[np.float64], run: Path | None = None,
+                      episodes: int = 10) -> dict[str, Any]:
     """`episodes` frozen test episodes (greedy, no TD updates) of the learnt value `weights`
     from starts with both hands at floor level, all recorded: the native runner's dict
     ("test_trajectories", "test_returns", "test_reached", "test_ends", …). Seeded by the
-    preset (after one frozen episode from the training start rule, which the runner needs);
-    what Fig. 7d and 8 draw."""
+    preset (after one frozen episode from the training start rule, which the runner needs), in
+    the latent space of the run in directory `run`; what Fig. 7d and 8 draw."""
     task = task_of(preset).replace(FLOOR_TESTS)
-    fitted = fit(preset)
+    fitted = fit(preset, run)
     return _native.run_task_trials(
         task._native, decoder=fitted.model.decoder_, encoder=fitted.model.loop_encoder_, latent_low=fitted.low,
         latent_high=fitted.high, demos=fitted.demos, n_trials=1, episodes=1, base_seed=preset.seed,

@@ -19,9 +19,10 @@ from latentrl.plots import latent_run_figures, latent_value_panel, link_position
 from latentrl.task import Task
 
 
-def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], out: Path) -> None:
-    """Fig. 7b, 7c, 7d, 7e, 7f (ours: the styles) and 8 into `out` (PNG + PDF)."""
-    fitted = fit(preset)
+def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], run: Path, out: Path) -> None:
+    """Fig. 7b, 7c, 7d, 7e, 7f (ours: the styles) and 8 of the run in directory `run` into `out`
+    (PNG + PDF)."""
+    fitted = fit(preset, run)
     task = task_of(preset)
     config = task.to_dict()
     maps: dict[str, Any] = {}
@@ -30,7 +31,7 @@ def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], out: Path) -> 
         learner=config["learner"], panel=lambda ax, w: _latent_panel(ax, preset, task, fitted, w, maps),
     )
     _style_counts(preset, arrays, fitted, out)
-    floor = floor_level_tests(preset, np.asarray(arrays["latent_weights"])[0])
+    floor = floor_level_tests(preset, np.asarray(arrays["latent_weights"])[0], run)
     paths = floor["test_trajectories"][0]
     fig, ax = plt.subplots(figsize=(5, 5))
     _side_view(ax, config)

@@ -1,11 +1,14 @@
-"""What the latent-space experiments' setups share: the GPLVM fit and its latent box, which
-episodes keep their paths, the fitted GPLVM's metadata for the results, and the native trial
-runner bound to a task, a GPLVM and its latent box."""
+"""What the latent-space experiments' setups share: the GPLVM fit and its latent box (a run's
+own, read back from its directory), which episodes keep their paths, the fitted GPLVM's
+metadata for the results, and the native trial runner bound to a task, a GPLVM and its latent
+box."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -13,7 +16,8 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl.experiments.presets import latent_box
-from latentrl.experiments.runner import RunTrials, Setup
+from latentrl.experiments.results import as_saved, read_json
+from latentrl.experiments.runner import MODEL_FILE, RunTrials, Setup
 from latentrl.gplvm import GPLVM
 from latentrl.task import Task
 
@@ -31,8 +35,34 @@ class Fitted:
     def of(cls, demos: NDArray[np.float64], *, seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
         """The fit of `demos` (deterministic in `seed`) and its box with `margin` per side."""
         model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder).fit(demos)
+        return cls.of_model(model, margin)
+
+    @classmethod
+    def of_model(cls, model: GPLVM, margin: float) -> Fitted:
+        """A fitted `model`, its training postures as the demos and its box with `margin`."""
         low, high = latent_box(model.Z_, margin)
-        return cls(demos, model, low, high)
+        return cls(model.X_train_, model, low, high)
+
+
+def run_fit(run: Path | str | None, margin: float, refit: Callable[[], Fitted]) -> Fitted:
+    """The fit of the run in directory `run`: the GPLVM its trials learnt in, read from
+    `MODEL_FILE`, so its figures, replays and resumes use that latent space on any machine (a
+    refit on another CPU or BLAS can land elsewhere: docs/robustness.md). `refit()` without a
+    run, or before the run's first save; for a run saved before models were kept, `refit()`
+    checked against the fit results.json records."""
+    meta_path = None if run is None else Path(run) / "results.json"
+    if meta_path is None or not meta_path.exists():
+        return refit()
+    model_path = meta_path.parent / MODEL_FILE
+    fitted = Fitted.of_model(GPLVM.load(model_path), margin) if model_path.exists() else refit()
+    saved, now = read_json(meta_path).get("setup", {}).get("gplvm"), as_saved(gplvm_info(fitted.model))
+    if saved is not None and saved != now:
+        source = f"{model_path} (nll {now['nll']})" if model_path.exists() else (
+            f"the GPLVM refitted on this machine (nll {now['nll']}; the run has no {MODEL_FILE}, and another CPU "
+            "or BLAS can fit another latent space)")
+        raise ValueError(f"{source} is not the one the saved trials used (nll {saved.get('nll')}, "
+                         f"{meta_path}); refusing to mix them: restore the run's files, or start a new run with --out")
+    return fitted
 
 
 def recorded_episodes(episodes: int) -> list[int]:
@@ -121,4 +151,4 @@ def latent_setup(
         "recorded_test_episodes": recorded_tests(preset.test_episodes),
         "task": task.to_dict(),
     }
-    return Setup(learners={"latent": learner}, info=info)
+    return Setup(learners={"latent": learner}, info=info, model=model)

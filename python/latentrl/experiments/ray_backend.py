@@ -55,7 +55,7 @@ def run_chunk(experiment: str, preset: Any, fingerprint: str, learner: str, firs
 
 @lru_cache(maxsize=64)
 def _worker_setup(experiment: str, preset: Any) -> Setup:
-    return rl_experiments()[experiment].setup(preset)
+    return rl_experiments()[experiment].setup(preset, None)
 
 
 @lru_cache(maxsize=1)
@@ -147,7 +147,7 @@ class RayBackend:
                                 continue
                             kind = rl_experiments()[job.experiment]
                             try:  # here, not in the cells' threads: pyplot is not thread-safe
-                                kind.figures(job.cell.preset, load_arrays(job.out), job.out)
+                                kind.figures(job.cell.preset, load_arrays(job.out), job.out, job.out)
                             except Exception as err:  # noqa: BLE001 - reported with the cell
                                 failures[job.cell.id] = err
                                 continue
@@ -217,5 +217,5 @@ class RayBackend:
                chunk=self.batch, execute=execute)
 
 
-def _no_figures(_preset: Any, _arrays: Mapping[str, np.ndarray], _out: Path) -> None:
+def _no_figures(_preset: Any, _arrays: Mapping[str, np.ndarray], _run: Path, _out: Path) -> None:
     """The cells' threads draw nothing; the driver's main thread does."""

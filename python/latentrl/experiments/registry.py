@@ -19,19 +19,20 @@ class RlExperiment(NamedTuple):
 
     preset: type
     """Its frozen preset dataclass."""
-    setup: Callable[[Any], Setup]
-    """`setup(preset)`: the learners and the facts results.json records."""
+    setup: Callable[[Any, Path | None], Setup]
+    """`setup(preset, run_dir)`: the learners and the facts results.json records (with a run
+    directory, in the model saved there)."""
     figures_module: str
-    """The module whose `figures(preset, arrays, out_dir)` draws the run's figures, imported
-    only to draw (matplotlib, the `[plot]` extra)."""
+    """The module whose `figures(preset, arrays, run_dir, out_dir)` draws the run's figures,
+    imported only to draw (matplotlib, the `[plot]` extra)."""
     learners: tuple[str, ...]
     """The learners `setup` builds, by name."""
     task: Callable[[Any], dict[str, Any]]
     """`task(preset)`: the effective task keys of a preset (nested tables), e.g. for `--help`."""
 
-    def figures(self, preset: Any, arrays: Mapping[str, np.ndarray], out_dir: Path) -> None:
-        """Draws the figures of a run of `preset` from its `arrays` into `out_dir`."""
-        importlib.import_module(self.figures_module).figures(preset, arrays, out_dir)
+    def figures(self, preset: Any, arrays: Mapping[str, np.ndarray], run_dir: Path, out_dir: Path) -> None:
+        """Draws the figures of the run of `preset` in `run_dir` from its `arrays` into `out_dir`."""
+        importlib.import_module(self.figures_module).figures(preset, arrays, run_dir, out_dir)
 
     def run(self, preset: Any, out_dir: Path | str, *, progress: bool = True) -> dict[str, Any]:
         """Runs (or continues) `preset` into `out_dir` with the one runner, figures included; without

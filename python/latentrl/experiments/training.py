@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from latentrl.demos import load_demos
-from latentrl.experiments.latent_runs import latent_setup
+from latentrl.experiments.latent_runs import Fitted, latent_setup, run_fit
 from latentrl.experiments.presets import latent_box
 from latentrl.experiments.runner import Setup, finished_trials, load_arrays
 from latentrl.gplvm import GPLVM
@@ -53,22 +53,27 @@ def _load(task_file: str, overrides: tuple[tuple[str, Any], ...], demos: str, mo
     return task, postures.postures, gplvm
 
 
-def fitted(run: TrainRun) -> tuple[Task, np.ndarray, GPLVM]:
-    """The task (with the run's overrides), the demo postures and the GPLVM (fitted or loaded);
-    cached, so validation and setup share the fit."""
+def fitted(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GPLVM]:
+    """The task (with the run's overrides), the demo postures and the GPLVM (fitted or loaded;
+    with `out`, the one saved in that run directory: `latent_runs.run_fit`); cached, so
+    validation and setup share the fit."""
     overrides = tuple(sorted(run.task.items()))
-    return _load(run.task_file, overrides, run.demos, run.model, run.seed, run.gplvm_max_iter, run.encoder)
+    task, demos, model = _load(run.task_file, overrides, run.demos, run.model, run.seed, run.gplvm_max_iter,
+                               run.encoder)
+    if out is not None:
+        model = run_fit(out, run.latent_margin, lambda: Fitted.of_model(model, run.latent_margin)).model
+    return task, demos, model
 
 
-def setup(run: TrainRun) -> Setup:
-    """The task's learner on the GPLVM's latent box."""
-    task, demos, model = fitted(run)
+def setup(run: TrainRun, out: Path | None = None) -> Setup:
+    """The task's learner on the GPLVM's latent box (the run's in directory `out`)."""
+    task, demos, model = fitted(run, out)
     return latent_setup(run, task, model, latent_box(model.Z_, run.latent_margin), demos)
 
 
 def save_policy(run: TrainRun, out: Path) -> LatentPolicy:
     """`out/policy.npz` from the finished trials of the run in `out`."""
-    task, demos, model = fitted(run)
+    task, demos, model = fitted(run, out)
     arrays, done = finished_trials(load_arrays(out))
     if not done:
         raise ValueError(f"{out}: no finished trial, so no policy")

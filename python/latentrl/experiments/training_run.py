@@ -24,10 +24,10 @@ def run_training(run: TrainRun, out_dir: Path | str, *, progress: bool = True) -
     return meta
 
 
-def figures(run: TrainRun, arrays: Mapping[str, np.ndarray], out: Path) -> None:
+def figures(run: TrainRun, arrays: Mapping[str, np.ndarray], run_dir: Path, out: Path) -> None:
     """`returns.png` (mean ± s.d. over trials, running mean) and, with d = 2, `value_before.png`,
     `value_after.png` (trial 1), PNG + PDF."""
-    task, _, model = fitted(run)
+    task, _, model = fitted(run, run_dir)
     learner = task.to_dict()["learner"]
     fig, ax = plt.subplots(figsize=(6, 4))
     learning_curves(ax, {"latent": arrays["latent"]}, window=max(1, min(100, run.episodes // 5)))
