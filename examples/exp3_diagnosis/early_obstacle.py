@@ -13,20 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
-from latentrl import _native
-from latentrl.cli import saved_run
-from latentrl.experiments import exp3
+from saved_policies import load
 
 EARLY = 10
 out = Path(sys.argv[1])
 starts = int(sys.argv[2]) if len(sys.argv) > 2 else 200
-_, preset = saved_run(out)
-fitted = exp3.fit(preset, out)
-task = exp3.task_of(preset)
+_, fitted, task, policies = load(out)
 learner = task.to_dict()["learner"]
-with np.load(out / "returns.npz") as npz:
-    weights = npz["latent_weights"]
-trials = int(sys.argv[3]) if len(sys.argv) > 3 else len(weights)
+trials = int(sys.argv[3]) if len(sys.argv) > 3 else len(policies)
 low, high = fitted.low, fitted.high
 spacing = (high - low) / (learner["rbf_per_dim"] - 1)
 directions = np.array([[1, 0], [-1, 0], [0, 1], [0, -1], [1, 1], [1, -1], [-1, 1], [-1, -1]], float)
@@ -50,8 +44,7 @@ rng = np.random.default_rng(12345)
 totals = {"episodes": 0, "obstacle": 0, "early": 0, "avoidable": 0, "hold_clear": 0}
 early_z = []
 for t in range(trials):
-    policy = _native.LatentPolicy(learner, list(low), list(high), weights[t], fitted.model.decoder_,
-                                  fitted.model.loop_encoder_)
+    policy = policies[t]
     for _ in range(starts):
         z0 = rng.uniform(low, high)
         posture = decode(z0[None])[0]

@@ -16,22 +16,17 @@ from pathlib import Path
 import numpy as np
 
 from latentrl import _native
-from latentrl.cli import saved_run
-from latentrl.experiments import exp3
+from saved_policies import load
 
 LAST = 3
 DIRECTIONS = np.array([[1, 0], [-1, 0], [0, 1], [0, -1], [1, 1], [1, -1], [-1, 1], [-1, -1]], float)
 out = Path(sys.argv[1])
 starts = int(sys.argv[2]) if len(sys.argv) > 2 else 50
 first = int(sys.argv[3]) if len(sys.argv) > 3 else 0
-_, preset = saved_run(out)
-fitted = exp3.fit(preset, out)
-task = exp3.task_of(preset)
+_, fitted, task, policies = load(out)
 config = task.to_dict()
 learner, max_steps = config["learner"], config["episode"]["max_steps"]
-with np.load(out / "returns.npz") as npz:
-    weights = npz["latent_weights"]
-trials = int(sys.argv[4]) if len(sys.argv) > 4 else len(weights) - first
+trials = int(sys.argv[4]) if len(sys.argv) > 4 else len(policies) - first
 low, high = fitted.low, fitted.high
 steps = learner["step"] * (high - low) / (learner["rbf_per_dim"] - 1)
 if learner["actions"] != "axes_and_diagonals":
@@ -66,8 +61,7 @@ rng = np.random.default_rng(12345 + first)
 totals = {m: {"episodes": 0, "success": 0, "at_h_at_end": 0, "ends": {}} for m in ("learnt", "masked")}
 seen = {"obstacle": 0, "touching_target_last": 0}
 for t in range(first, first + trials):
-    policy = _native.LatentPolicy(learner, list(low), list(high), weights[t], fitted.model.decoder_,
-                                  fitted.model.loop_encoder_)
+    policy = policies[t]
     for _ in range(starts):
         posture = decode(rng.uniform(low, high)[None])[0]
         if plant.reset(posture) is not None:

@@ -13,21 +13,14 @@ from pathlib import Path
 
 import numpy as np
 
-from latentrl import _native
-from latentrl.cli import saved_run
-from latentrl.experiments import exp3
+from saved_policies import load
 
 LAST = 3
 out = Path(sys.argv[1])
 starts = int(sys.argv[2]) if len(sys.argv) > 2 else 200
-_, preset = saved_run(out)
-fitted = exp3.fit(preset, out)
-task = exp3.task_of(preset)
-learner = task.to_dict()["learner"]
+_, fitted, task, policies = load(out)
 max_steps = task.to_dict()["episode"]["max_steps"]
-with np.load(out / "returns.npz") as npz:
-    weights = npz["latent_weights"]
-trials = int(sys.argv[3]) if len(sys.argv) > 3 else len(weights)
+trials = int(sys.argv[3]) if len(sys.argv) > 3 else len(policies)
 low, high = fitted.low, fitted.high
 plant, judge = task.plant(fitted.demos), task.plant(fitted.demos)
 
@@ -35,8 +28,7 @@ rng = np.random.default_rng(12345)
 totals = {"episodes": 0, "obstacle": 0, "obstacle_seen_last": 0, "obstacle_seen_any": 0,
           "timeout": 0, "timeout_touching_target": 0, "targets": 0, "targets_touching": 0}
 for t in range(trials):
-    policy = _native.LatentPolicy(learner, list(low), list(high), weights[t], fitted.model.decoder_,
-                                  fitted.model.loop_encoder_)
+    policy = policies[t]
     for _ in range(starts):
         z0 = rng.uniform(low, high)
         if plant.reset(fitted.model.inverse_transform(z0[None])[0]) is not None:
