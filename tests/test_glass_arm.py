@@ -13,6 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from latentrl import cli
+
 from learning import CONTROL_ALPHA, assert_separated
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -68,6 +70,13 @@ def test_the_readme_commands_train_save_and_roll_out(runs):
     meta = json.loads((runs["learner"] / "results.json").read_text())
     assert meta["preset"]["name"] == "TrainRun" and meta["setup"]["task"]["name"] == "glass_arm"
     assert (runs["learner"] / "policy.npz").is_file() and (runs["learner"] / "returns.png").is_file()
+
+
+def test_rollout_softmax_runs_the_policy_as_the_frozen_tests_did(runs, tmp_path):
+    assert cli.main(["rollout", str(runs["learner"]), "--out", str(tmp_path), "--episodes", "3", "--softmax",
+                     "--no-progress"]) == 0
+    rollout = json.loads((tmp_path / "rollout.json").read_text())
+    assert rollout["policy_kind"] == "softmax" and sum(rollout["ends"].values()) == 2 * 3
 
 
 def test_a_finished_run_is_not_overwritten_and_resume_keeps_it(runs):

@@ -78,6 +78,11 @@ def test_a_saved_policy_loads_acts_and_rolls_out_the_same(arms_model: GPLVM, tmp
     np.testing.assert_array_equal(once["returns"], again["returns"])
     assert once["returns"].shape == (2, 4) and 0.0 <= once["summary"]["reached"] <= 1.0
     assert sum(once["summary"]["ends"].values()) == 8
+    drawn = [loaded.rollout(4, seed=s, softmax=True) for s in (2, 2, 3)]
+    np.testing.assert_array_equal(drawn[0]["returns"], drawn[1]["returns"])
+    assert drawn[0]["returns"].shape == (2, 4) and not np.array_equal(drawn[0]["returns"], once["returns"])
+    assert drawn[0]["paths"].shape[:2] == once["paths"].shape[:2] == (2, 4)
+    assert not np.array_equal(drawn[0]["returns"], drawn[2]["returns"])
     # The greedy step: act() moves the encoded posture by one action and decodes it.
     target = policy.act(posture)
     assert target.shape == (4,) and np.isfinite(target).all()

@@ -153,12 +153,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     _add_preset_flags(train, TrainRun, exclude=("task_file", "demos", "model"))
     _add_task_flags(train, _native.task_schema())  # defaults: the task file's, else these
-    rollout = sub.add_parser("rollout", help="run a trained policy (greedy, no learning) and write OUT/rollout.json")
+    rollout = sub.add_parser("rollout", help="run a trained policy (greedy or soft-max, no learning) and write OUT/rollout.json")
     rollout.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz), or a policy.npz")
     rollout.add_argument("--out", type=Path, required=True, help="where to write rollout.json and rollout.npz")
     rollout.add_argument("--episodes", type=int, default=20, help="episodes per trial (default: 20)")
     rollout.add_argument("--trial", type=int, help="only this trial's policy (default: every trial)")
     rollout.add_argument("--seed", type=int, default=0, help="base seed of the starts (default: 0)")
+    rollout.add_argument("--softmax", action="store_true",
+                         help="draw each action from the learner's soft-max, as a run's frozen tests do (default: greedy)")
     rollout.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     fit = sub.add_parser("fit", help="fit a PCA or GPLVM to a demonstration file and save it (NPZ)")
     fit.add_argument("demos", type=Path, help="demonstrated postures: .csv (header of joint names), .npz or .json")
@@ -291,13 +293,14 @@ def _rollout(args: argparse.Namespace) -> int:
             bar.total = total
             bar.update(done - bar.n)
 
-        result = policy.rollout(args.episodes, trial=args.trial, seed=args.seed, progress=report)
+        result = policy.rollout(args.episodes, trial=args.trial, seed=args.seed, softmax=args.softmax, progress=report)
     args.out.mkdir(parents=True, exist_ok=True)
     from latentrl.experiments.results import write_npz
 
     write_npz(args.out / "rollout.npz", {k: result[k] for k in ("returns", "ends", "reached", "paths")})
     summary = {"policy": str(path), "task": policy.task.name, "trials": result["trials"], "episodes": args.episodes,
-               "seed": args.seed, **result["summary"], "environment": environment()}
+               "seed": args.seed, "policy_kind": "softmax" if args.softmax else "greedy", **result["summary"],
+               "environment": environment()}
     write_json(args.out / "rollout.json", summary)
     print(json.dumps({k: summary[k] for k in ("reached", "ends", "mean_return")}))
     return 0

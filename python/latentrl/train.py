@@ -183,21 +183,32 @@ class LatentPolicy:
             raise ValueError(f"trial must be an int in 0..{len(self._native) - 1}, got {trial!r}")
         return self._native[int(trial)]
 
-    def rollout(self, episodes: int = 20, *, trial: int | None = None, seed: int = 0,
+    def rollout(self, episodes: int = 20, *, trial: int | None = None, seed: int = 0, softmax: bool = False,
                 progress: Any = None) -> dict[str, Any]:
-        """Runs the greedy policy (no learning) for `episodes` episodes per trial (every trial,
-        or `trial`) from the task's start rule; returns the native dict (returns, ends, reached,
-        trajectories of every episode, …) plus "reached" as the fraction and "ends" as counts
-        per ending in "summary"."""
+        """Runs the policy (no learning) for `episodes` episodes per trial (every trial, or
+        `trial`) from the task's start rule; returns the native dict (returns, ends, reached,
+        trajectories of the first 20 episodes, …) plus "reached" as the fraction and "ends" as
+        counts per ending in "summary". The policy is greedy (what `act` does), or with
+        `softmax` draws each action from the learner's soft-max on the learnt V, as a run's
+        frozen test episodes do (on Exp 3 the greedy policy lifts from fewer starts:
+        docs/exp3.md); those episodes follow one greedy episode, which the native runner needs."""
         trials = range(len(self.weights)) if trial is None else [self._check_trial(trial)]
+        task = self.task.replace({"episode.test_start": "any"}) if softmax else self.task
+        recorded = list(range(min(episodes, 20)))
         runs = []
         for t in trials:
-            runs.append(_native.run_task_trials(
-                self.task._native, decoder=self.model.decoder_, encoder=self.model.loop_encoder_,
+            run = _native.run_task_trials(
+                task._native, decoder=self.model.decoder_, encoder=self.model.loop_encoder_,
                 latent_low=self.latent_low, latent_high=self.latent_high, demos=self.demos, n_trials=1,
-                episodes=episodes, base_seed=seed, first_trial=t, weights=self.weights[t], rollout=True,
-                record_episodes=list(range(min(episodes, 20))), progress=progress,
-            ))
+                episodes=1 if softmax else episodes, base_seed=seed, first_trial=t, weights=self.weights[t],
+                rollout=True, record_episodes=[] if softmax else recorded,
+                test_episodes=episodes if softmax else 0, record_test_episodes=recorded if softmax else [],
+                progress=progress,
+            )
+            if softmax:
+                run.update(returns=run["test_returns"], ends=run["test_ends"], reached=run["test_reached"],
+                           trajectories=run["test_trajectories"])
+            runs.append(run)
         ends = np.concatenate([r["ends"] for r in runs])
         reached = np.concatenate([r["reached"] for r in runs])
         names = end_reasons()
