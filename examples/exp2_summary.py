@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from latentrl.experiments.runner import load_arrays
+from latentrl.experiments.sweep_summary import episodes_to_threshold
 from latentrl.task import end_reasons
 
 WINDOW = 500
@@ -29,9 +30,9 @@ for name, r in (("first", first), ("last", last)):
     print(f"mean return, {name} {WINDOW}: {r.mean():.1f} ± {r.std(ddof=1):.1f} ({r.min():.0f}-{r.max():.0f})")
 late = reached[:, -WINDOW:].mean(1)
 print(f"reached h*, last {WINDOW}: {100 * late.mean():.1f} % ({100 * late.min():.1f}-{100 * late.max():.1f} per trial)")
-rate = np.stack([np.convolve(r, np.ones(WINDOW) / WINDOW, mode="valid") for r in reached.astype(float)])
-onset = [int(np.argmax(r >= 0.9)) + WINDOW if (r >= 0.9).any() else None for r in rate]
-print(f"first episode with running reach (window {WINDOW}) >= 90 %: {onset} (median {np.median([o for o in onset if o]):.0f})")
+onset = episodes_to_threshold(reached.astype(float), 0.9, WINDOW)  # -1: never
+print(f"first episode with running reach (window {WINDOW}) >= 90 %: {onset.tolist()} "
+      f"(median {np.median(onset[onset >= 0]):.0f})")
 p = passed[:, -WINDOW:].mean(1)
 print(f"passed, last {WINDOW}: {100 * p.min():.1f}-{100 * p.max():.1f} % per trial")
 names = end_reasons()

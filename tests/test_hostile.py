@@ -88,6 +88,12 @@ def test_class_4_a_run_without_its_model_refuses_a_refit_that_differs(finished_r
         exp1.fit(preset, finished_run)  # what replays and figures decode with
 
 
+def test_class_4_a_corrupt_saved_model_is_named(finished_run, capsys):
+    (finished_run / "gplvm.npz").write_bytes(b"not a zip")
+    assert cli.main(["run", "exp1", "--resume", str(finished_run), "--no-progress"]) == 1
+    assert "gplvm.npz" in capsys.readouterr().err
+
+
 def test_class_4_an_unedited_run_resumes(finished_run):
     resumes_unchanged(finished_run)
 

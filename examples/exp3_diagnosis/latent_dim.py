@@ -18,7 +18,8 @@ from latentrl.experiments.exp3 import Exp3Preset
 from latentrl.task import end_reasons
 
 d = int(sys.argv[1])
-trials, episodes, tests = (int(a) for a in (sys.argv[2:5] + ["2", "1500", "100"][len(sys.argv[2:5]):]))
+given = [int(a) for a in sys.argv[2:5]]
+trials, episodes, tests = given + [2, 1500, 100][len(given):]
 preset = Exp3Preset()
 model = GPLVM(n_components=d, max_iter=preset.gplvm_max_iter, random_state=preset.seed,
               encoder=preset.encoder).fit(shipped_demos("humanoid_lift"))

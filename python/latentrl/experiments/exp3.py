@@ -121,7 +121,7 @@ def setup(preset: Exp3Preset, run: Path | None = None) -> Setup:
 
 def floor_level_tests(preset: Exp3Preset, weights: NDArray[np.float64], run: Path | None = None,
                       episodes: int = 10) -> dict[str, Any]:
-    """`episodes` frozen test episodes (greedy, no TD updates) of the learnt value `weights`
+    """`episodes` frozen test episodes (the soft-max on the frozen V, no TD updates) of the learnt value `weights`
     from starts with both hands at floor level, all recorded: the native runner's dict
     ("test_trajectories", "test_returns", "test_reached", "test_ends", …). Seeded by the
     preset (after one frozen episode from the training start rule, which the runner needs), in

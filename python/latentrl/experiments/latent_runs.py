@@ -54,10 +54,11 @@ def run_fit(run: Path | str | None, margin: float, refit: Callable[[], Fitted]) 
     if meta_path is None or not meta_path.exists():
         return refit()
     model_path = meta_path.parent / MODEL_FILE
-    fitted = Fitted.of_model(GPLVM.load(model_path), margin) if model_path.exists() else refit()
+    kept = model_path.exists()
+    fitted = Fitted.of_model(GPLVM.load(model_path), margin) if kept else refit()
     saved, now = read_json(meta_path).get("setup", {}).get("gplvm"), as_saved(gplvm_info(fitted.model))
     if saved is not None and saved != now:
-        source = f"{model_path} (nll {now['nll']})" if model_path.exists() else (
+        source = f"{model_path} (nll {now['nll']})" if kept else (
             f"the GPLVM refitted on this machine (nll {now['nll']}; the run has no {MODEL_FILE}, and another CPU "
             "or BLAS can fit another latent space)")
         raise ValueError(f"{source} is not the one the saved trials used (nll {saved.get('nll')}, "
