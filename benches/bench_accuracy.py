@@ -7,7 +7,7 @@ Run it in the bench venv (MuJoCo and matplotlib are never dependencies of latent
     bash benches/setup_bench_env.sh
     benches/.venv-bench/bin/python benches/bench_accuracy.py [--quick]
 
-Writes `benches/results/bench_accuracy.json` and `docs/figures/accuracy-{arms,humanoid}.png`;
+Writes `benches/results/bench_accuracy.json` and `docs/figures/accuracy-{arms,humanoid,glass_arm}.png`;
 docs/performance.md reads them (`--quick`: `bench_accuracy-quick.json` and the figures in
 benches/results/).
 
@@ -22,6 +22,9 @@ friction, no self-collisions), built here at other time steps and solver setting
   `Sim.reset_on_ground`, soles 0.5 mm above the floor, MuJoCo's base at the same height) for
   0.5 s, then goes to the shipped lift demos 6, 5 and 6, 1 s each: the targets move along the
   joint-space line in the first 0.25 s, then hold. 3.5 s.
+- glass_arm: the README's own-robot tutorial (`examples/glass_arm/`, a task file beside its
+  URDF): fixed root, 3 joints, kp 2000, kd 20, cap 100 N·m (the URDF's effort); the line through
+  5 of its demos spread over `demos.csv`, 0.5 s per segment, hold 0.5 s: 2.5 s. Tracked: `glass`.
 
 The targets change once per RL step (0.05 s, every sample); in between the engine takes
 0.05 s / dt physics steps in one call. Sampled after every RL step: the joint positions and
@@ -32,8 +35,8 @@ References, at dt 1/16000 s: rapier at 4 solver iterations × 4 PGS passes, MuJo
 default solver (Newton, tolerance 1e-8) and the `implicitfast` integrator (at dt 1/4000 the
 humanoid's had not converged; each reference is checked against its engine at twice the step
 and at other solver settings). The grid: dt 1/120, 1/240, 1/480, 1/960 s and, to see where the
-humanoid gets near the tolerance, 1/1920 and 1/3840 s; rapier (solver iterations, PGS passes) (1, 1), (1, 4), (2, 1), (2, 4),
-(4, 1); MuJoCo `implicitfast` and `discrete`. Per setting: position error = the largest
+humanoid gets near the tolerance, 1/1920 and 1/3840 s; rapier (solver iterations, PGS passes) (1, 1), (1, 4), (2, 1), (2, 4), (3, 4),
+(4, 1), (4, 4); MuJoCo `implicitfast` and `discrete`. Per setting: position error = the largest
 distance of a tracked point from the same point of the reference over the samples, hand error
 (hands only), joint error (largest joint-angle difference), against the engine's own
 reference and against the other engine's; a run that yields a non-finite value has diverged,
@@ -79,13 +82,14 @@ from latentrl import LatentrlError
 from latentrl.datasets import arm_postures
 from latentrl.envs import shipped_demos
 from latentrl.experiments.results import write_json
+from latentrl.robot_info import urdf_info
 from latentrl.task import Task
 
 ROOT = Path(__file__).resolve().parent.parent
 RL_DT = DT * SUBSTEPS  # 0.05 s: one sample, one change of the targets
 # The issue's time steps, and two finer ones to see where the humanoid gets near 1 mm.
 DTS = (1 / 120, 1 / 240, 1 / 480, 1 / 960, 1 / 1920, 1 / 3840)
-RAPIER_ITERATIONS = ((1, 1), (1, 4), (2, 1), (2, 4), (4, 1))  # (solver iterations, PGS passes)
+RAPIER_ITERATIONS = ((1, 1), (1, 4), (2, 1), (2, 4), (3, 4), (4, 1), (4, 4))  # (solver iterations, PGS passes)
 # At dt 1/4000 the humanoid's references had not converged (rapier 1.3 mm from its 1/8000 run,
 # MuJoCo 11 mm from its 1/16000 one), so both engines' references take dt 1/16000.
 REFERENCE_DT = 1 / 16000
@@ -103,7 +107,13 @@ MUJOCO_REFERENCE_CHECKS = (
 )
 TOLERANCE = 1e-3  # m: every tracked point within 1 mm of the reference at every sample
 TOLERANCES = (TOLERANCE, 5e-3, 1e-2)  # the cheapest settings are also given at looser ones
-TASKS = {"arms": "two_arms", "humanoid": "humanoid_lift"}  # the shipped task of each plant
+GLASS_ARM = ROOT / "examples" / "glass_arm"  # the README's own-robot tutorial
+# The task of each plant: a shipped one by name, or a task file
+TASKS: dict[str, str | Path] = {
+    "arms": "two_arms",
+    "humanoid": "humanoid_lift",
+    "glass_arm": GLASS_ARM / "glass_arm.toml",
+}
 FELL = Task.shipped("humanoid_lift").to_dict()["fall"]["base_height_fraction"]
 MIN_REPEATS, MAX_REPEATS, MIN_TIMED_S = 3, 20, 0.3
 FIGURES = ROOT / "docs" / "figures"
@@ -135,25 +145,43 @@ def line(points: np.ndarray, knots: np.ndarray, times: np.ndarray) -> np.ndarray
     return np.stack([np.interp(times, knots, points[:, j]) for j in range(points.shape[1])], axis=1)
 
 
-def arms_plant() -> Plant:
-    task = Task.shipped(TASKS["arms"])
-    postures = arm_postures(5, np.random.default_rng(0))
+def task_of(plant: str) -> Task:
+    name = TASKS[plant]
+    return Task.load(name) if isinstance(name, Path) else Task.shipped(name)
+
+
+def through(name: str, postures: np.ndarray, gains: dict[str, float]) -> Plant:
+    """A fixed-root plant whose targets follow the line through `postures`, 0.5 s per segment,
+    then hold the last one 0.5 s."""
+    task = task_of(name)
     knots = 0.5 * np.arange(len(postures))
-    # RL step k aims at the path's point at its end, (k + 1) RL_DT; the last posture is held 0.5 s
+    # RL step k aims at the path's point at its end, (k + 1) RL_DT
     times = RL_DT * np.arange(1, round((knots[-1] + 0.5) / RL_DT) + 1)
     return Plant(
-        "arms",
-        task.urdf_path,
-        ARMS,
-        postures[0],
-        line(postures, knots, times),
-        tuple(task.effectors),
+        name, task.urdf_path, gains, postures[0], line(postures, knots, times), tuple(task.effectors)
     )
 
 
+def arms_plant() -> Plant:
+    return through("arms", arm_postures(5, np.random.default_rng(0)), ARMS)
+
+
+def glass_arm_plant() -> Plant:
+    """The tutorial's arm through 5 of its demos spread over the file (physics_check's default
+    path), at its task's gains and its URDF's effort limit (the cap rapier applies; MuJoCo's
+    force range)."""
+    task = task_of("glass_arm")
+    demos = np.loadtxt(GLASS_ARM / "demos.csv", delimiter=",", skiprows=1)
+    efforts = {j["effort"] for j in urdf_info(task.urdf_path)["joints"] if j["name"] in task.joint_names}
+    assert len(efforts) == 1, f"one force range for all joints expected, got {efforts}"
+    servo = task.to_dict()["servo"]
+    gains = {"kp": servo["kp"], "kd": servo["kd"], "max_force": min(servo["max_force"], *efforts)}
+    return through("glass_arm", demos[np.linspace(0, len(demos) - 1, 5).round().astype(int)], gains)
+
+
 def humanoid_plant() -> Plant:
-    task = Task.shipped(TASKS["humanoid"])
-    demos = shipped_demos(TASKS["humanoid"])
+    task = task_of("humanoid")
+    demos = shipped_demos("humanoid_lift")
     home = np.zeros(len(task.joint_names))
     poses = [home, home, demos[6], demos[6], demos[5], demos[5], demos[6], demos[6]]
     knots = np.array([0.0, 0.5, 0.75, 1.5, 1.75, 2.5, 2.75, 3.5])
@@ -450,6 +478,7 @@ def case(plant: Plant, *, quick: bool) -> dict[str, Any]:
             "points": [*plant.hands, *([f"{plant.root} (base)"] if plant.root else [])],
         },
         "gains": plant.gains,
+        "tolerance_m": task_of(plant.name).to_dict()["physics"]["tolerance"],
         "start_base_height_m": height if plant.root else None,
         "references": references,
         "rows": rows,
@@ -498,7 +527,7 @@ def within(r: dict[str, Any], ref: str, tolerance: float) -> bool:
 def shipped(plant: str, rows: list[dict[str, Any]]) -> dict[str, Any]:
     """The task file's rapier setting: its errors, and the cheapest MuJoCo setting at least as
     close to its own reference (and its cost over that one's)."""
-    physics = Task.shipped(TASKS[plant]).to_dict()["physics"]
+    physics = task_of(plant).to_dict()["physics"]
     dt, it, pgs = physics["dt"], physics["solver_iterations"], physics["pgs_iterations"]
     r = next(
         r
@@ -732,7 +761,7 @@ def main(argv: list[str] | None = None) -> int:
         f"{env['cpu_model']}, {env['cpu_count']} CPUs, load average {env['load_average'][0]:.2f}"
     )
     started = time.perf_counter()
-    cases = {p.name: case(p, quick=args.quick) for p in (arms_plant(), humanoid_plant())}
+    cases = {p.name: case(p, quick=args.quick) for p in (arms_plant(), humanoid_plant(), glass_arm_plant())}
     for name, data in cases.items():
         figure(name, data, figures / f"accuracy-{name}.png")
         for tol, c in data["cheapest_within"].items():

@@ -1,6 +1,9 @@
 """The shipped tasks' physics hold their tolerance against a fine-step reference (issue #20,
 docs/performance.md): the arms within 1 mm, the humanoid within 10 mm (no setting of rapier or
-MuJoCo reaches 1 mm on it), along paths through their demos; and a coarse setting fails."""
+MuJoCo reaches 1 mm on it), the README tutorial's glass arm within 1 mm, along paths through
+their demos; and a coarse setting fails."""
+
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,15 +12,25 @@ from latentrl import Task
 from latentrl.envs import shipped_demos
 from latentrl.physics_check import REFERENCE, demo_path, physics_error, reference_of
 
-PATHS = {"two_arms": None, "humanoid_lift": (6, 5, 6)}
+GLASS_ARM = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+
+
+def task_and_demos(name: str) -> tuple[Task, np.ndarray]:
+    """A shipped task and its demos, or the README tutorial's glass arm from its task file."""
+    if name == "glass_arm":
+        return Task.load(GLASS_ARM / "glass_arm.toml"), np.loadtxt(GLASS_ARM / "demos.csv", delimiter=",", skiprows=1)
+    return Task.shipped(name), shipped_demos(name)
+
+
+PATHS = {"two_arms": None, "humanoid_lift": (6, 5, 6), "glass_arm": None}
 """Demos in turn: the arms' default (5 spread over the file), the humanoid's squat up and down
 (the accuracy bench's moves)."""
 
 
 @pytest.mark.parametrize("name", sorted(PATHS))
-def test_shipped_physics_hold_their_tolerance(name):
-    task = Task.shipped(name)
-    error = physics_error(task, shipped_demos(name), PATHS[name])
+def test_task_physics_hold_their_tolerance(name):
+    task, demos = task_and_demos(name)
+    error = physics_error(task, demos, PATHS[name])
     assert error["simulated_s"] >= 2.5
     assert 0 < error["position_m"] <= error["tolerance_m"], error  # the task file's physics.tolerance
     assert error["within"] is True
