@@ -167,8 +167,8 @@ def arms_plant() -> Plant:
 
 
 def glass_arm_plant() -> Plant:
-    """The tutorial's arm through 5 of its demos spread over the file (physics_check's default
-    path), at its task's gains and its URDF's effort limit (the cap rapier applies; MuJoCo's
+    """The tutorial's arm through 5 of its demos spread over the file (those physics_check's
+    default path visits, there in faster moves), at its task's gains and its URDF's effort limit (the cap rapier applies; MuJoCo's
     force range)."""
     task = task_of("glass_arm")
     demos = np.loadtxt(GLASS_ARM / "demos.csv", delimiter=",", skiprows=1)
