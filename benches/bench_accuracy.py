@@ -80,6 +80,7 @@ from bench_sim import (
 )
 from latentrl import LatentrlError
 from latentrl.datasets import arm_postures
+from latentrl.demos import load_demos
 from latentrl.envs import shipped_demos
 from latentrl.experiments.results import write_json
 from latentrl.robot_info import urdf_info
@@ -171,7 +172,7 @@ def glass_arm_plant() -> Plant:
     default path visits, there in faster moves), at its task's gains and its URDF's effort limit (the cap rapier applies; MuJoCo's
     force range)."""
     task = task_of("glass_arm")
-    demos = np.loadtxt(GLASS_ARM / "demos.csv", delimiter=",", skiprows=1)
+    demos = load_demos(GLASS_ARM / "demos.csv", expected_joints=task.joint_names).postures
     efforts = {j["effort"] for j in urdf_info(task.urdf_path)["joints"] if j["name"] in task.joint_names}
     assert len(efforts) == 1, f"one force range for all joints expected, got {efforts}"
     servo = task.to_dict()["servo"]

@@ -10,7 +10,7 @@ physics step. Paths, 120 RL steps per episode:
   path bench_accuracy times);
 - `random`: from a random demo, the targets move to another random demo every RL step, as the
   learner's change every RL step.
-Plants: `sim` (`_native.Sim`: robot and floor only), `task` (`Task.plant`: the Exp 3 plant with
+Plants: `sim` (`_native.Sim` as bench_sim builds it: robot and floor only), `task` (`Task.plant`: the Exp 3 plant with
 its obstacle block and end rules, stepped on after a rule fires), `task_no_block` (the same
 without the block). The cases are interleaved over ROUNDS rounds of EPISODES episodes and the
 median of the rounds is reported: on a 2-core VM single runs of a few seconds vary by ±15 %.
@@ -27,13 +27,12 @@ from typing import Any
 
 import numpy as np
 
+from bench_sim import RapierRobot
 from latentrl import Task
-from latentrl._native import Sim
 from latentrl.envs import shipped_demos
 from latentrl.experiments.results import environment, write_json
 
 ROUNDS, EPISODES, STEPS = 8, 8, 120
-CLEARANCE = 5e-4  # m: the soles above the floor at a Sim reset (as bench_sim)
 
 Path_ = Callable[[np.ndarray, np.random.Generator], tuple[np.ndarray, list[np.ndarray]]]
 
@@ -49,21 +48,20 @@ def random(demos: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, lis
 
 
 class SimPlant:
-    """`_native.Sim` with the task's robot, servo and physics, driven like a plant."""
+    """bench_sim's `RapierRobot` with the task's robot, servo and physics, driven like a plant."""
 
     def __init__(self, task: Task) -> None:
         t = task.to_dict()
-        physics = {k: t["physics"][k] for k in ("dt", "substeps", "solver_iterations", "pgs_iterations")}
-        servo = {k: t["servo"][k] for k in ("kp", "kd", "max_force")}
-        self.sim = Sim(task.urdf_path, root="floating", floor=0.0, physics=physics, servo=servo)
+        physics = t["physics"]
+        self.robot = RapierRobot(task.urdf_path, floating=True, gains=t["servo"],
+                                 iterations=physics["solver_iterations"], pgs_iterations=physics["pgs_iterations"],
+                                 floor=0.0, sole="l_foot", dt=physics["dt"], substeps=physics["substeps"])
         self.substeps = physics["substeps"]
-
-    def reset(self, posture: np.ndarray) -> None:
-        self.sim.reset_on_ground(posture, "l_foot", CLEARANCE)
+        self.reset = self.robot.reset
 
     def step(self, target: np.ndarray) -> None:
-        self.sim.set_targets(target)
-        self.sim.step(self.substeps)
+        self.robot.set_targets(target)
+        self.robot.step(self.substeps)
 
 
 def round_cost(make: Callable[[], Any], path: Path_, seed: int, substeps: int) -> float:

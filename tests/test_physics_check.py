@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from latentrl import Task
+from latentrl.demos import load_demos
 from latentrl.envs import shipped_demos
 from latentrl.physics_check import REFERENCE, demo_path, physics_error, reference_of
 
@@ -18,7 +19,8 @@ GLASS_ARM = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
 def task_and_demos(name: str) -> tuple[Task, np.ndarray]:
     """A shipped task and its demos, or the README tutorial's glass arm from its task file."""
     if name == "glass_arm":
-        return Task.load(GLASS_ARM / "glass_arm.toml"), np.loadtxt(GLASS_ARM / "demos.csv", delimiter=",", skiprows=1)
+        task = Task.load(GLASS_ARM / "glass_arm.toml")
+        return task, load_demos(GLASS_ARM / "demos.csv", expected_joints=task.joint_names).postures
     return Task.shipped(name), shipped_demos(name)
 
 
