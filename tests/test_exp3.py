@@ -125,7 +125,8 @@ def test_results_layout_follows_spec(quick_run):
     with np.load(out / "returns.npz") as npz:
         assert npz["latent"].shape == npz["latent_end"].shape == (preset.trials, preset.episodes)
         assert npz["latent_test"].shape == (preset.trials, preset.test_episodes)
-        assert npz["latent_weights"].shape == (preset.trials, 20**2)
+        # V's 20 × 20 weights, then a move correction per action (8), the task's move_correction.
+        assert npz["latent_weights"].shape == (preset.trials, 20**2 * (1 + 8))
         assert npz["latent_test_paths"].shape[-1] == 6 + 7 + 19
         # Both hands at the start of every frozen test: the first row of each recorded test path.
         starts = npz["latent_test_start_hands"]

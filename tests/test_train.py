@@ -66,8 +66,13 @@ def test_same_seed_same_policy_and_value_matches_weights(arms_model: GPLVM) -> N
     )
 
 
-def test_a_saved_policy_loads_acts_and_rolls_out_the_same(arms_model: GPLVM, tmp_path: Path) -> None:
-    policy = train_latent_policy(arms_model, trials=2, episodes=5, overrides={"episode.max_steps": 30}, test_episodes=0)
+@pytest.mark.parametrize("move_correction", [False, True])
+def test_a_saved_policy_loads_acts_and_rolls_out_the_same(arms_model: GPLVM, tmp_path: Path, move_correction: bool) -> None:
+    overrides = {"episode.max_steps": 30, "learner.move_correction": move_correction}
+    policy = train_latent_policy(arms_model, trials=2, episodes=5, overrides=overrides, test_episodes=0)
+    # V's weights over the 20 × 20 grid, then with corrections one block per action (8).
+    assert policy.weights.shape == (2, 400 * (9 if move_correction else 1))
+    assert policy.value(arms_model.Z_).shape == (40,)
     policy.save(tmp_path / "policy.npz")
     loaded = LatentPolicy.load(tmp_path / "policy.npz")
     np.testing.assert_array_equal(loaded.weights, policy.weights)

@@ -403,10 +403,11 @@ def learner_values(
     learner: Mapping[str, object],
     low: Sequence[float],
     high: Sequence[float],
-    weights: NDArray[np.float64],
+    weights: NDArray[np.float64] | None,
     points: NDArray[np.float64],
 ) -> NDArray[np.float64]:
-    """V(z) = wᵀ b(z) (Eq. 7) at `points` (M, d): the learner's own sparse features."""
+    """V(z) = wᵀ b(z) (Eq. 7) at `points` (M, d): the learner's own sparse features; weights
+    None: as built (w₀)."""
 
 def task_schema() -> list[dict[str, Any]]:
     """Every key of a task file as dicts `{key, doc, rule, kind, default}`."""

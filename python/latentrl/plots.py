@@ -88,7 +88,7 @@ def variance_shade(variance: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def latent_value_grid(
-    weights: NDArray[np.float64],
+    weights: NDArray[np.float64] | None,
     low: NDArray[np.float64],
     high: NDArray[np.float64],
     model: Any,
@@ -96,19 +96,19 @@ def latent_value_grid(
     learner: Mapping[str, Any],
     grid: int,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """The learner's V of `weights` on a `grid` × `grid` mesh over the latent box [low, high]
+    """The learner's V of `weights` (None: before learning) on a `grid` × `grid` mesh over the latent box [low, high]
     (rows from low z2 to high): the mesh (g0, g1), V on it, and the decoded postures (grid²,
     D) and GPLVM variances (grid²,) of its points, row by row."""
     g0, g1 = np.meshgrid(np.linspace(low[0], high[0], grid), np.linspace(low[1], high[1], grid))
     points = np.column_stack([g0.ravel(), g1.ravel()])
     postures, variance = model.decoder_.predict(points)
-    value = _native.learner_values(dict(learner), list(low), list(high), np.asarray(weights, dtype=np.float64), points)
+    value = _native.learner_values(dict(learner), list(low), list(high), None if weights is None else np.asarray(weights, dtype=np.float64), points)
     return g0, g1, value.reshape(g0.shape), postures, variance
 
 
 def latent_value_panel(
     ax: Axes,
-    weights: NDArray[np.float64],
+    weights: NDArray[np.float64] | None,
     low: NDArray[np.float64],
     high: NDArray[np.float64],
     model: Any,
@@ -117,7 +117,7 @@ def latent_value_panel(
     regions: Regions | None = None,
     grid: int = 120,
 ) -> None:
-    """V over the 2-D latent box [low, high] (the learner's own V of `weights`, native), the GPLVM
+    """V over the 2-D latent box [low, high] (the learner's own V of `weights`, native; None: w₀), the GPLVM
     variance of `model.decoder_` shaded (darker = higher, log scale), the experiment's `regions`
     and the demonstrations' latent points `model.Z_` (white dots) (paper Fig. 6b/d, 7b/c)."""
     g0, g1, value, postures, variance = latent_value_grid(weights, low, high, model, learner=learner, grid=grid)
@@ -143,26 +143,25 @@ def latent_run_figures(
     *,
     names: tuple[str, str, str],
     title: str,
-    learner: Mapping[str, Any],
-    panel: Callable[[Axes, NDArray[np.float64]], None],
+    panel: Callable[[Axes, NDArray[np.float64] | None], None],
 ) -> None:
     """A latent learner's return curve (`names[0]`: mean ± s.d. over trials, running mean of
     min(`curve_window`, episodes // 5)) and its value function before (`names[1]`: the
     initial weight everywhere) and after learning (`names[2]`: trial 1), each drawn by
-    `panel(ax, weights)`; the latter only if the run kept its weights. `learner`: the task's
-    learner configuration (its grid and w₀)."""
+    `panel(ax, weights)` (None: before learning); the latter only if the run kept its
+    weights."""
     fig, ax = plt.subplots(figsize=(6, 4))
     window = max(1, min(preset.curve_window, preset.episodes // 5))
     learning_curves(ax, {"latent": arrays["latent"]}, window=window)
     ax.set_title(title)
     save_figure(fig, out_dir, names[0])
     weights = arrays.get("latent_weights")
-    before = np.full(int(learner["rbf_per_dim"]) ** 2, float(learner["initial_weight"]))
-    for name, w, when in ((names[1], before, "before learning"), (names[2], weights, "after learning (trial 1)")):
-        if w is None:
-            continue
+    drawn = [(names[1], None, "before learning")]
+    if weights is not None:
+        drawn.append((names[2], np.asarray(weights)[0], "after learning (trial 1)"))
+    for name, w, when in drawn:
         fig, ax = plt.subplots(figsize=(6, 5))
-        panel(ax, np.asarray(w)[0] if w.ndim == 2 else np.asarray(w))
+        panel(ax, w)
         ax.set_title(f"value function {when}")
         save_figure(fig, out_dir, name)
 

@@ -39,6 +39,12 @@ params! {
         /// A latent target whose GPLVM variance exceeds this ends the episode with the penalty
         /// and no plant step (SPEC §3.2); none (default) turns it off.
         variance_threshold: Option<f64> = None => Rule::Positive,
+        /// Ours, not the paper's: also learn for every action a correction `C_a(z) = c_aᵀ b(z)`
+        /// of its look-ahead, `Q(z, a) = V(z + Δ_a) + C_a(z)`, from each move's own outcome
+        /// (`c_a ← c_a + α (r + γ V(s') − Q(z, a)) b(z)`): what V cannot hold, such as a move
+        /// that meets an obstacle on the way to a clear target. The weights then hold
+        /// 1 + actions blocks (V's first). Off (default): Eq. 11, `Q(z, a) = V(z + Δ_a)`.
+        move_correction: bool = false => Rule::Any,
     }
 }
 

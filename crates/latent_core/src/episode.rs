@@ -200,11 +200,14 @@ impl Learner {
         }
     }
 
-    /// TD(0) update (Eq. 7–9) of the features `b`, unless the learner is frozen.
+    /// TD(0) update (Eq. 7–9) of the features `b` after `action`, whose look-ahead was `q`,
+    /// and of that action's move correction if learnt, unless the learner is frozen.
     #[inline]
-    fn learn(&mut self, b: &SparseFeatures, reward: f64, v_next: Option<f64>) {
+    fn learn(&mut self, b: &SparseFeatures, action: usize, q: f64, reward: f64, v_next: Option<f64>) {
         if self.phase.learns() {
+            let target = reward + self.td.gamma() * v_next.unwrap_or(0.0);
             self.td.update(b, reward, v_next);
+            self.td.correct(b, action, target - q);
         }
     }
 
@@ -263,7 +266,7 @@ impl Learner {
     ) -> StepResult {
         let dim = self.grid.dim();
         // 1. Look-ahead Q(z, u_i) = V(z + Δ_i) (Eq. 11) and soft-max draw (Eq. 10).
-        self.look_ahead(&s.z, &mut s.candidate, &mut s.q, &mut s.rbf);
+        self.look_ahead(&s.z, &s.current, &mut s.candidate, &mut s.q, &mut s.rbf);
         let a = if self.phase == Phase::Rollout {
             greedy(&s.q)
         } else {
@@ -272,14 +275,15 @@ impl Learner {
         // 2.–5. z' = z + Δ_a, box, decode, plant, encode.
         shifted(&s.z, &self.displacements[a * dim..(a + 1) * dim], &mut s.candidate);
         let result = transition(plant, space, &self.bounds(), &s.candidate, &mut s.step);
+        let q = s.q[a];
         if result.end.is_some() {
-            self.learn(&s.current, result.reward, None);
+            self.learn(&s.current, a, q, result.reward, None);
             return result;
         }
         // 6. TD(0) with bootstrap.
         self.grid.eval_into(&s.step.next, &mut s.rbf, &mut s.next);
         let v_next = self.td.value(&s.next);
-        self.learn(&s.current, result.reward, Some(v_next));
+        self.learn(&s.current, a, q, result.reward, Some(v_next));
         std::mem::swap(&mut s.current, &mut s.next);
         std::mem::swap(&mut s.z, &mut s.step.next);
         result
@@ -485,6 +489,83 @@ mod tests {
         assert!(
             last_hits < first_hits,
             "obstacle endings: first {first_hits}, last {last_hits}"
+        );
+    }
+
+    /// [`Corridor`] with a thin wall at 0.5 instead: a move that crosses it ends on it
+    /// (reward −1), whatever its target; starts just left of it or at 0.7, right of it.
+    struct Wall {
+        x: f64,
+    }
+
+    impl Plant for Wall {
+        fn posture_dim(&self) -> usize {
+            1
+        }
+        fn task_dim(&self) -> usize {
+            1
+        }
+        fn sample_start<R: Rng + ?Sized>(&mut self, rng: &mut R, posture: &mut [f64]) {
+            posture[0] = if rng.random_bool(0.5) { 0.49 } else { 0.7 };
+        }
+        fn reset(&mut self, posture: &[f64]) -> Option<EndReason> {
+            self.x = posture[0];
+            None
+        }
+        fn step(&mut self, target: &[f64], reached: &mut [f64]) -> StepOutcome {
+            let crossed = (self.x < 0.5) != (target[0] < 0.5);
+            self.x = target[0];
+            reached[0] = self.x;
+            StepOutcome {
+                reward: if crossed { -1.0 } else { self.x },
+                end: crossed.then_some(EndReason::Obstacle),
+            }
+        }
+        fn task_position(&self, out: &mut [f64]) {
+            out[0] = self.x;
+        }
+    }
+
+    #[test]
+    fn move_corrections_learn_a_move_that_v_cannot() {
+        // Beyond the wall V learns the larger rewards from the starts there, so V alone keeps
+        // looking right from 0.49; the correction of "right" learns that the move ends on the
+        // wall.
+        let hits = |move_correction: bool| {
+            let config = LearnerConfig {
+                rbf_per_dim: 11,
+                alpha: 0.5,
+                step: 0.2,
+                move_correction,
+                ..LearnerConfig::default()
+            };
+            let mut l = Learner::new(&config, rules(20, StartMode::Plant), &[0.0], &[1.0]).unwrap();
+            assert_eq!(l.weights().len(), if move_correction { 3 * 11 } else { 11 });
+            let mut plant = Wall { x: 0.0 };
+            let mut rng = ChaCha8Rng::seed_from_u64(3);
+            let mut s = l.scratch(&StateSpace::Full, 1);
+            let ends: Vec<EndReason> = (0..300)
+                .map(|_| {
+                    l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, None)
+                        .unwrap()
+                        .end
+                })
+                .collect();
+            let greedy = l.greedy_target(&[0.49]).unwrap()[0];
+            (
+                ends[200..].iter().filter(|&&e| e == EndReason::Obstacle).count(),
+                greedy,
+            )
+        };
+        let (plain, plain_greedy) = hits(false);
+        let (corrected, corrected_greedy) = hits(true);
+        assert!(
+            plain > 30 && plain_greedy > 0.5,
+            "V alone: {plain} hits, greedy to {plain_greedy}"
+        );
+        assert!(
+            corrected < 5 && corrected_greedy < 0.49,
+            "with corrections: {corrected} hits, greedy to {corrected_greedy}"
         );
     }
 

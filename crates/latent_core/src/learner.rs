@@ -8,7 +8,7 @@ use crate::config::LearnerConfig;
 use crate::error::Result;
 use crate::params::Params;
 use crate::policy::{SoftmaxPolicy, check_actions};
-use crate::rbf::{RbfConfig, RbfGrid, RbfScratch};
+use crate::rbf::{RbfConfig, RbfGrid, RbfScratch, SparseFeatures};
 use crate::space::StateSpace;
 use crate::td::TdLearner;
 
@@ -112,7 +112,14 @@ impl Learner {
             .chunks_exact(dim)
             .flat_map(|u| u.iter().zip(grid.spacing()).map(|(u, h)| config.step * h * u))
             .collect();
-        let td = TdLearner::new(grid.len(), config.alpha, config.gamma, config.initial_weight)?;
+        let corrections = if config.move_correction { n_actions } else { 0 };
+        let td = TdLearner::new(
+            grid.len(),
+            corrections,
+            config.alpha,
+            config.gamma,
+            config.initial_weight,
+        )?;
         let policy = SoftmaxPolicy::new(config.beta)?;
         Ok(Self {
             grid,
@@ -141,7 +148,7 @@ impl Learner {
         &self.grid
     }
 
-    /// The value-function weights `w`.
+    /// The value-function weights `w`, then the move corrections' blocks if any.
     pub fn weights(&self) -> &[f64] {
         self.td.weights()
     }
@@ -181,16 +188,24 @@ impl Learner {
         space.check(self.grid.dim(), posture_dim)
     }
 
-    /// The look-ahead values `Q(z, u_i) = V(z + Δ_i)` (Eq. 11) into `q`, one per action;
+    /// The look-ahead values `Q(z, u_i) = V(z + Δ_i)` (Eq. 11), plus the move corrections
+    /// `C_i(z)` if learnt, into `q`, one per action; `b_z` are the features of `z` and
     /// `candidate` is a `dim`-long buffer.
     #[inline]
-    pub(crate) fn look_ahead(&self, z: &[f64], candidate: &mut [f64], q: &mut [f64], rbf: &mut RbfScratch) {
+    pub(crate) fn look_ahead(
+        &self,
+        z: &[f64],
+        b_z: &SparseFeatures,
+        candidate: &mut [f64],
+        q: &mut [f64],
+        rbf: &mut RbfScratch,
+    ) {
         let dim = self.grid.dim();
-        for (q, d) in q.iter_mut().zip(self.displacements.chunks_exact(dim)) {
+        for (a, (q, d)) in q.iter_mut().zip(self.displacements.chunks_exact(dim)).enumerate() {
             for ((c, z), d) in candidate.iter_mut().zip(z).zip(d) {
                 *c = z + d;
             }
-            *q = self.grid.value(self.td.weights(), candidate, rbf);
+            *q = self.grid.value(self.td.weights(), candidate, rbf) + self.td.correction(b_z, a);
         }
     }
 
@@ -201,7 +216,10 @@ impl Learner {
         let dim = self.grid.dim();
         let mut q = vec![0.0; self.n_actions];
         let mut target = vec![0.0; dim];
-        self.look_ahead(z, &mut target, &mut q, &mut self.grid.scratch());
+        let mut rbf = self.grid.scratch();
+        let mut b_z = self.grid.features();
+        self.grid.eval_into(z, &mut rbf, &mut b_z);
+        self.look_ahead(z, &b_z, &mut target, &mut q, &mut rbf);
         let a = greedy(&q);
         for (k, t) in target.iter_mut().enumerate() {
             *t = (z[k] + self.displacements[a * dim + k]).clamp(self.grid.low()[k], self.grid.high()[k]);

@@ -2,7 +2,8 @@
 //!
 //! `V(s) = wᵀ b(s)` (Eq. 7), TD error `δ_t = r_t + γ V(s_{t+1}) − V(s_t)` (Eq. 8) and the
 //! update `w ← w + α δ_t b(s_t)` (Eq. 9). A terminal transition (an episode ended by a
-//! penalty) uses `V(s_{t+1}) = 0`.
+//! penalty) uses `V(s_{t+1}) = 0`. With `LearnerConfig::move_correction` the weights also
+//! hold one block `c_a` per action after `w`, each learnt towards the same target.
 
 use crate::error::{CoreError, Result};
 use crate::rbf::SparseFeatures;
@@ -11,27 +12,32 @@ use crate::rbf::SparseFeatures;
 #[derive(Debug, Clone)]
 pub struct TdLearner {
     weights: Vec<f64>,
+    n_features: usize,
     alpha: f64,
     gamma: f64,
 }
 
 impl TdLearner {
-    /// `n_features` weights set to `initial_weight`, learning rate `alpha` and discount `gamma`
-    /// (their rules are [`crate::LearnerConfig`]'s).
-    pub fn new(n_features: usize, alpha: f64, gamma: f64, initial_weight: f64) -> Result<Self> {
+    /// `n_features` weights of V set to `initial_weight`, then `corrections` blocks of
+    /// `n_features` zeros; learning rate `alpha` and discount `gamma` (their rules are
+    /// [`crate::LearnerConfig`]'s).
+    pub fn new(n_features: usize, corrections: usize, alpha: f64, gamma: f64, initial_weight: f64) -> Result<Self> {
         if n_features == 0 {
             return Err(CoreError::Empty {
                 what: "value-function features",
             });
         }
+        let mut weights = vec![initial_weight; n_features];
+        weights.resize(n_features * (1 + corrections), 0.0);
         Ok(Self {
-            weights: vec![initial_weight; n_features],
+            weights,
+            n_features,
             alpha,
             gamma,
         })
     }
 
-    /// The weights `w`, one per feature.
+    /// The weights: `w`, one per feature, then the correction blocks.
     pub fn weights(&self) -> &[f64] {
         &self.weights
     }
@@ -71,6 +77,28 @@ impl TdLearner {
         features.dot(&self.weights)
     }
 
+    /// The correction `C_a = c_aᵀ b` of block `action` (0 without corrections).
+    #[inline]
+    pub fn correction(&self, features: &SparseFeatures, action: usize) -> f64 {
+        let start = self.n_features * (1 + action);
+        self.weights
+            .get(start..start + self.n_features)
+            .map_or(0.0, |c| features.dot(c))
+    }
+
+    /// `c_a ← c_a + α · error · b`, `error` being the TD target minus the look-ahead `Q(z, a)`;
+    /// nothing without corrections.
+    #[inline]
+    pub fn correct(&mut self, features: &SparseFeatures, action: usize, error: f64) {
+        let start = self.n_features * (1 + action);
+        if let Some(c) = self.weights.get_mut(start..start + self.n_features) {
+            let step = self.alpha * error;
+            for (&i, &b) in features.indices.iter().zip(&features.values) {
+                c[i] += step * b;
+            }
+        }
+    }
+
     /// One TD(0) update from `b(s_t)`, reward `r_t` and `V(s_{t+1})` — `None` for a terminal
     /// transition, i.e. `V(s_{t+1}) = 0`. Returns `δ_t = r_t + γ V(s_{t+1}) − V(s_t)`
     /// (Eq. 8) after applying `w ← w + α δ_t b(s_t)` (Eq. 9).
@@ -98,7 +126,7 @@ mod tests {
 
     #[test]
     fn update_follows_eq_8_and_9() {
-        let mut td = TdLearner::new(4, 0.5, 0.9, 1.0).unwrap();
+        let mut td = TdLearner::new(4, 0, 0.5, 0.9, 1.0).unwrap();
         let b = features(&[(1, 0.25), (2, 0.75)]);
         assert_eq!(td.value(&b), 1.0);
         // δ = 0.3 + 0.9·2 − 1 = 1.1; w_i += 0.5·1.1·b_i.
@@ -111,8 +139,23 @@ mod tests {
     }
 
     #[test]
+    fn corrections_are_blocks_after_v_and_leave_it_alone() {
+        let mut td = TdLearner::new(3, 2, 0.5, 0.9, 7.0).unwrap();
+        assert_eq!(td.weights(), [7.0, 7.0, 7.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let b = features(&[(0, 0.5), (2, 0.5)]);
+        // c_1 += 0.5 · (−4) · b: block 1 is weights 6..9.
+        td.correct(&b, 1, -4.0);
+        assert_eq!(td.weights(), [7.0, 7.0, 7.0, 0.0, 0.0, 0.0, -1.0, 0.0, -1.0]);
+        assert_eq!(td.correction(&b, 1), -1.0);
+        assert_eq!(td.correction(&b, 0), 0.0);
+        assert_eq!(td.value(&b), 7.0);
+        let plain = TdLearner::new(3, 0, 0.5, 0.9, 7.0).unwrap();
+        assert_eq!(plain.correction(&b, 0), 0.0);
+    }
+
+    #[test]
     fn terminal_uses_zero_next_value() {
-        let mut td = TdLearner::new(2, 0.9, 0.95, 0.5).unwrap();
+        let mut td = TdLearner::new(2, 0, 0.9, 0.95, 0.5).unwrap();
         let b = features(&[(0, 1.0)]);
         let delta = td.update(&b, -1.0, None);
         assert!((delta - (-1.5)).abs() < 1e-15);
@@ -123,7 +166,7 @@ mod tests {
     fn converges_to_the_fixed_point_of_a_chain() {
         // Two states, one-hot features: s0 → s1 (r = 0), s1 → terminal (r = 1).
         // Fixed point: V(s1) = 1, V(s0) = γ.
-        let mut td = TdLearner::new(2, 0.3, 0.9, 0.0).unwrap();
+        let mut td = TdLearner::new(2, 0, 0.3, 0.9, 0.0).unwrap();
         let (b0, b1) = (features(&[(0, 1.0)]), features(&[(1, 1.0)]));
         for _ in 0..200 {
             let v1 = td.value(&b1);
@@ -136,6 +179,6 @@ mod tests {
 
     #[test]
     fn needs_a_feature() {
-        assert!(TdLearner::new(0, 0.9, 0.95, 0.0).is_err());
+        assert!(TdLearner::new(0, 0, 0.9, 0.95, 0.0).is_err());
     }
 }

@@ -322,7 +322,7 @@ pub(crate) fn pack_results<'py>(
         "trials",
         PyArray1::from_vec(py, results.iter().map(|r| r.trial as i64).collect::<Vec<i64>>()),
     )?;
-    let m = template.grid().len();
+    let m = template.weights().len();
     if options.keep_weights {
         let mut w = Vec::with_capacity(results.len() * m);
         for r in results {

@@ -450,21 +450,23 @@ pub fn run_task_trials<'py>(
 }
 
 /// V(z) = wᵀ b(z) (Eq. 7) at `points` (M, d) for the learner `learner` (a dict of LearnerConfig
-/// keys) over the latent box [low, high] with weights (M',): the learner's own sparse features,
-/// as its look-ahead sees them.
+/// keys) over the latent box [low, high] with weights (M',), or as built (w₀) if none: the
+/// learner's own sparse features, as its look-ahead sees them.
 #[pyfunction]
 pub fn learner_values<'py>(
     py: Python<'py>,
     learner: &Bound<'py, PyAny>,
     low: Vec<f64>,
     high: Vec<f64>,
-    weights: PyReadonlyArray1<'py, f64>,
+    weights: Option<PyReadonlyArray1<'py, f64>>,
     points: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     guard(|| {
         let config: latent_core::LearnerConfig = config_from("learner", learner)?;
         let mut l = Learner::new(&config, Default::default(), &low, &high).map_err(to_py)?;
-        l.set_weights(&weights.as_array().to_vec()).map_err(to_py)?;
+        if let Some(w) = &weights {
+            l.set_weights(&w.as_array().to_vec()).map_err(to_py)?;
+        }
         let z = crate::convert::points("points", &points)?;
         if z.nrows() != low.len() {
             return Err(invalid(format!(

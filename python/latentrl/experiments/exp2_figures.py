@@ -33,7 +33,7 @@ def figures(preset: Exp2Preset, arrays: Mapping[str, np.ndarray], run: Path, out
     _fig5(preset, fitted, out)
     latent_run_figures(
         preset, arrays, out, names=("fig6a", "fig6b", "fig6d"), title="Exp 2: two planar arms, mean ± s.d. over trials",
-        learner=config["learner"], panel=lambda ax, w: _latent_panel(ax, task, fitted, w, config["learner"]),
+        panel=lambda ax, w: _latent_panel(ax, task, fitted, w, config["learner"]),
     )
     fig, ax = plt.subplots(figsize=(6, 4.5))
     _walls(ax, config)
@@ -56,7 +56,7 @@ def _walls(ax: Axes, config: Mapping[str, Any]) -> None:
 
 
 def _latent_panel(
-    ax: Axes, task: Task, fitted: Fitted, weights: NDArray[np.float64], learner: Mapping[str, Any], grid: int = 120
+    ax: Axes, task: Task, fitted: Fitted, weights: NDArray[np.float64] | None, learner: Mapping[str, Any], grid: int = 120
 ) -> None:
     """`plots.latent_value_panel` with the task's rules mapped into latent space by the native
     plant: black where the decoded hands are in a wall, red lines around the postures that break

@@ -28,7 +28,7 @@ def figures(preset: Exp3Preset, arrays: Mapping[str, np.ndarray], run: Path, out
     maps: dict[str, Any] = {}
     latent_run_figures(
         preset, arrays, out, names=("fig7e", "fig7b", "fig7c"), title="Exp 3: humanoid lift, mean ± s.d. over trials",
-        learner=config["learner"], panel=lambda ax, w: _latent_panel(ax, preset, task, fitted, w, maps),
+        panel=lambda ax, w: _latent_panel(ax, preset, task, fitted, w, maps),
     )
     _style_counts(preset, arrays, fitted, out)
     floor = floor_level_tests(preset, np.asarray(arrays["latent_weights"])[0], run)
@@ -86,7 +86,7 @@ def _side_view(ax: Axes, config: Mapping[str, Any], dx: float = 0.0) -> None:
 
 
 def _latent_panel(
-    ax: Axes, preset: Exp3Preset, task: Task, fitted: Fitted, weights: NDArray[np.float64], maps: dict[str, Any]
+    ax: Axes, preset: Exp3Preset, task: Task, fitted: Fitted, weights: NDArray[np.float64] | None, maps: dict[str, Any]
 ) -> None:
     """`plots.latent_value_panel` on a `map_grid` grid with the decoded postures (clipped to the
     joint limits) that, standing at rest, break a rule of the task (the native plant's
