@@ -147,7 +147,8 @@ class LatentPolicy:
         self.task, self.model, self.demos = task, model, demos
         self.latent_low, self.latent_high = np.asarray(latent_low), np.asarray(latent_high)
         self.weights = np.asarray(weights, dtype=np.float64)
-        """(trials, rbf_per_dim^d) final TD(0) weights."""
+        """(trials, rbf_per_dim^d) final TD(0) weights of V; with `learner.move_correction`
+        (trials, rbf_per_dim^d · (1 + actions)): V's, then each action's correction."""
         self.preset = preset
         """The preset the trials ran with (None for a loaded policy)."""
         self.record = dict(record or {})
