@@ -205,7 +205,7 @@ impl Learner {
             for ((c, z), d) in candidate.iter_mut().zip(z).zip(d) {
                 *c = z + d;
             }
-            *q = self.grid.value(self.td.weights(), candidate, rbf) + self.td.correction(b_z, a);
+            *q = self.grid.value(self.td.value_weights(), candidate, rbf) + self.td.correction(b_z, a);
         }
     }
 
@@ -236,7 +236,7 @@ impl Learner {
             .chunks(dim)
             .map(|z| {
                 self.grid.check_point("latent point", z)?;
-                Ok(self.grid.value(self.td.weights(), z, &mut scratch))
+                Ok(self.grid.value(self.td.value_weights(), z, &mut scratch))
             })
             .collect()
     }

@@ -42,7 +42,13 @@ impl TdLearner {
         &self.weights
     }
 
-    /// Replaces `w` (e.g. with a saved policy's); its length must be the number of features.
+    /// V's weights `w` alone, one per feature.
+    #[inline]
+    pub fn value_weights(&self) -> &[f64] {
+        &self.weights[..self.n_features]
+    }
+
+    /// Replaces the weights (e.g. with a saved policy's); the length must be `weights()`'s.
     pub fn set_weights(&mut self, weights: &[f64]) -> Result<()> {
         if weights.len() != self.weights.len() {
             return Err(CoreError::Shape {
