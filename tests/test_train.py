@@ -119,7 +119,7 @@ def test_humanoid_task_runs() -> None:
                                  test_episodes=0)
     assert policy.returns.shape == (1, 2)
     assert np.isfinite(policy.returns).all()
-    assert policy.weights.shape == (1, 400)
+    assert policy.weights.shape == (1, 400 * (1 + 8))  # V, then the task's move corrections
     few = GPLVM(n_components=2, max_iter=20, random_state=0).fit(model.X_train_[:5])
     with pytest.raises(ValueError, match="episode.start_demo = 6 is not a row of the 5 demonstrations"):
         train_latent_policy(few, "humanoid_lift", overrides={"episode.start_demo": 6})
