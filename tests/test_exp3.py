@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from latentrl._native import run_task_trials
+from latentrl.cli import saved_run
 from latentrl.experiments import exp3
 from latentrl.experiments.exp3 import Exp3Preset
 from latentrl.experiments.registry import run_experiment
@@ -156,6 +157,36 @@ def test_same_seed_same_results_and_a_missing_trial_is_rerun_identically(tmp_pat
     with np.load(tmp_path / "a" / "returns.npz") as whole, np.load(tmp_path / "b" / "returns.npz") as resumed:
         assert whole.files == resumed.files
         for key in whole.files:
+            np.testing.assert_array_equal(whole[key], resumed[key], err_msg=key)
+
+
+def test_a_run_made_before_the_shipped_task_changed_is_plotted_and_resumed_as_it_ran(tmp_path):
+    # A run from before humanoid_lift.toml turned learner.move_correction on: no override, and no
+    # such key in its recorded task (the key's default is the behaviour before it existed).
+    old = with_overrides(TINY, {"learner.move_correction": False})
+    run_experiment("exp3", old, tmp_path / "a", progress=False)
+    run_experiment("exp3", old, tmp_path / "b", progress=False)
+    meta_path = tmp_path / "b" / "results.json"
+    meta = json.loads(meta_path.read_text())
+    meta["preset"]["task"] = {k: v for k, v in meta["preset"]["task"].items() if k != "learner.move_correction"}
+    del meta["setup"]["task"]["learner"]["move_correction"]
+    meta_path.write_text(json.dumps(meta))
+    _, preset = saved_run(tmp_path / "b")
+    assert preset.task["learner.move_correction"] is False
+    with np.load(tmp_path / "b" / "returns.npz") as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    arrays["latent_end"][1] = -1
+    arrays["preset_json"] = np.array(json.dumps(meta["preset"], sort_keys=True))
+    write_npz(tmp_path / "b" / "returns.npz", arrays)
+    # Continuing it with the shipped task as it is now would mix two learners: refused.
+    with pytest.raises(ValueError, match=r"ran with another task \(learner.move_correction differ\)"):
+        run_experiment("exp3", TINY, tmp_path / "b", progress=False)
+    for cmd in (["run", "exp3", "--resume"], ["plot"]):
+        result = subprocess.run([sys.executable, "-m", "latentrl", *cmd, str(tmp_path / "b")], capture_output=True,
+                                text=True, timeout=300)
+        assert result.returncode == 0, result.stderr
+    with np.load(tmp_path / "a" / "returns.npz") as whole, np.load(tmp_path / "b" / "returns.npz") as resumed:
+        for key in ("latent", "latent_end", "latent_weights"):
             np.testing.assert_array_equal(whole[key], resumed[key], err_msg=key)
 
 

@@ -21,7 +21,7 @@ from latentrl import _native
 from latentrl.experiments.presets import field_docs, with_overrides
 from latentrl.experiments.registry import experiments, task_schema
 from latentrl.experiments.results import environment, read_json, write_json
-from latentrl.task import by_path
+from latentrl.task import by_path, changed_since
 
 TASK_PREFIX = "task:"
 """Prefix of the argparse destinations of task keys (`task:learner.alpha`)."""
@@ -48,7 +48,27 @@ def saved_run(out_dir: Path, *, train: bool = False) -> tuple[str, Any]:
     unknown = sorted(set(fields) - {f.name for f in dataclasses.fields(preset_cls)})
     if unknown:
         raise ValueError(f"{out_dir}: its preset has fields this version does not know: {unknown}")
-    return name, preset_cls(**fields)
+    preset = preset_cls(**fields)
+    recorded = read_json(meta_path).get("setup", {}).get("task")
+    if name == "train" or recorded is None:
+        return name, preset
+    return name, _as_recorded(out_dir, name, preset, recorded)
+
+
+def _as_recorded(out_dir: Path, name: str, preset: Any, recorded: dict[str, Any]) -> Any:
+    """`preset` with a task override for every key it does not set whose recorded value this
+    version's task does not give (a shipped task file changed since the run): its figures, replays and resume
+    use the task its trials ran with. A key added since the run takes its default, the
+    behaviour before it. A key no override can set is a ValueError."""
+    rl = experiments()[name].rl
+    assert rl is not None
+    changed = {k: v for k, v in changed_since(recorded, rl.task(preset)).items() if k not in preset.task}
+    settable = {e["key"] for e in task_schema(name) if by_path(e)}
+    fixed = sorted(set(changed) - settable)
+    if fixed:
+        raise ValueError(f"{out_dir}: its trials ran with a task this version cannot rebuild ({', '.join(fixed)} "
+                         "differ and no override sets them); use the latentrl version that made it")
+    return dataclasses.replace(preset, task={**preset.task, **changed}) if changed else preset
 
 
 def _add_preset_flags(parser: argparse.ArgumentParser, preset_cls: type, exclude: tuple[str, ...] = ()) -> None:

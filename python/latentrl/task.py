@@ -47,6 +47,30 @@ def by_path(entry: Mapping[str, Any]) -> bool:
     return "." in key and "[]" not in key and "NAME" not in key
 
 
+def key_paths(table: Any) -> Any:
+    """A nested table (``{"learner": {"alpha": 0.5}}``) as key paths (``{"learner.alpha": 0.5}``);
+    anything but a mapping unchanged."""
+    if not isinstance(table, Mapping):
+        return table
+    out: dict[str, Any] = {}
+    for key, value in table.items():
+        if isinstance(value, Mapping):
+            out.update({f"{key}.{k}": v for k, v in key_paths(value).items()})
+        else:
+            out[key] = value
+    return out
+
+
+def changed_since(recorded: Mapping[str, Any], now: Mapping[str, Any]) -> dict[str, Any]:
+    """The keys (by path) whose value a run recorded in its task (`Task.to_dict()` then) differs
+    from the task `now`'s, with the recorded values; a settable key the record lacks (added
+    since) counts at its default, the behaviour before it existed."""
+    given = key_paths(recorded)
+    ran = {**{e["key"]: e["default"] for e in schema() if by_path(e)}, **given}
+    now = key_paths(now)
+    return {k: v for k, v in ran.items() if (k in now and now[k] != v) or (k in given and k not in now)}
+
+
 def _plain(value: Any) -> Any:
     """`value` with every tuple and list a fresh list and every dict a fresh dict."""
     if isinstance(value, dict):

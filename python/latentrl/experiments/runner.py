@@ -20,7 +20,7 @@ import numpy as np
 from latentrl.progress import progress_bar
 
 from latentrl._base import read_npz
-from latentrl.task import end_reasons
+from latentrl.task import changed_since, end_reasons, key_paths
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
     as_saved,
@@ -154,7 +154,7 @@ def run_rl(
     started = time.perf_counter()
     built = setup(preset, out)
     if meta is not None:
-        _check_same_shapes(meta, built, arrays, out)
+        _check_continued(meta, built, arrays, out)
     arrays[PRESET_KEY] = np.array(json.dumps(as_saved(plan), sort_keys=True))
     chunk = chunk or worker_threads()
     if built.model is not None and (meta is None or not (out / MODEL_FILE).exists()):
@@ -266,7 +266,8 @@ def _previous(
     if not meta_path.exists():
         return {}, None
     meta = read_json(meta_path)
-    if meta.get("preset") != plan:
+    ran = key_paths(meta.get("setup", {}).get("task") or {})
+    if _edited(meta.get("preset") or {}, as_saved(plan), ran):
         raise ValueError(
             f"{meta_path.parent} holds a run of a different preset; choose another --out "
             "or delete it (only a run of the same preset is continued)"
@@ -274,7 +275,7 @@ def _previous(
     if not arrays_path.exists():
         return {}, None
     arrays = load_arrays(arrays_path.parent)
-    _check_saved_run(meta_path.parent, plan, arrays)
+    _check_saved_run(meta_path.parent, plan, arrays, ran)
     return arrays, meta
 
 
@@ -283,21 +284,39 @@ PRESET_KEY = "preset_json"
 results.json whose preset was edited since."""
 
 
-def _check_saved_run(out: Path, plan: dict[str, Any], arrays: Mapping[str, np.ndarray]) -> None:
+def _edited(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any]) -> list[str]:
+    """The preset fields that differ between `saved` and `now`. A task override that only
+    restores what the trials ran with (`ran`: the recorded task by key path, empty if none was
+    recorded; a key added since is not in it) is not an edit: `cli.saved_run` adds those when a shipped task changed since."""
+    edited = [k for k in set(saved) | set(now) if k != "task" and saved.get(k) != now.get(k)]
+    before, after = saved.get("task") or {}, now.get("task") or {}
+    restored = {k for k in set(after) - set(before) if (k in ran and ran[k] == after[k]) or (ran and k not in ran)}
+    if {k for k in set(before) | set(after) if before.get(k) != after.get(k)} - restored:
+        edited.append("task")
+    return sorted(edited)
+
+
+def _check_saved_run(out: Path, plan: dict[str, Any], arrays: Mapping[str, np.ndarray], ran: Mapping[str, Any]) -> None:
     """The arrays of a run being continued were computed with `plan`; a ValueError naming the
     edited fields otherwise (mixing would be silently wrong)."""
     if PRESET_KEY in arrays:
         saved, now = json.loads(str(arrays[PRESET_KEY])), as_saved(plan)
-        edited = sorted(k for k in set(saved) | set(now) if saved.get(k) != now.get(k))
+        edited = _edited(saved, now, ran)
         if edited:
             changes = ", ".join(f"{k}: {saved.get(k)!r} in returns.npz, {now.get(k)!r} in results.json" for k in edited)
             raise ValueError(f"{out}/results.json was edited after its trials ran ({changes}); resume refuses to mix "
                              "the two: restore the file, or start a new run with --out")
 
 
-def _check_same_shapes(meta: Mapping[str, Any], built: Setup, arrays: Mapping[str, np.ndarray], out: Path) -> None:
-    """A continued run's per-episode arrays have the preset's shapes (its model fit is checked
-    where the setup reads it back: `latent_runs.run_fit`)."""
+def _check_continued(meta: Mapping[str, Any], built: Setup, arrays: Mapping[str, np.ndarray], out: Path) -> None:
+    """A continued run's trials ran with the task the setup builds and its per-episode arrays
+    have the preset's shapes (its model fit is checked where the setup reads it back:
+    `latent_runs.run_fit`)."""
+    recorded = meta.get("setup", {}).get("task")
+    keys = sorted(changed_since(recorded, as_saved(built.info.get("task")) or {})) if recorded is not None else []
+    if keys:
+        raise ValueError(f"{out}: its trials ran with another task ({', '.join(keys)} differ); resume refuses to "
+                         "mix the two: start a new run with --out")
     want = (meta["preset"]["trials"], meta["preset"]["episodes"])
     for name in built.learners:
         for what in PER_EPISODE:

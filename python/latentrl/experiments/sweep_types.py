@@ -19,7 +19,7 @@ from typing import Any, NamedTuple
 
 from latentrl.experiments.presets import describe, with_overrides
 from latentrl.experiments.registry import rl_experiments, task_schema
-from latentrl.task import by_path
+from latentrl.task import by_path, key_paths
 
 SWEEP_KEYS = ("experiment", "quick", "trials", "seed", "threshold", "base", "grid", "cells")
 """The keys of a sweep file, as the fields of `Sweep`."""
@@ -85,14 +85,14 @@ class Sweep:
             object.__setattr__(self, "threshold", threshold)
         kinds = _field_kinds(rl_experiments()[self.experiment].preset)
         kinds.update(_task_kinds(self.experiment))
-        base = _check_overrides("base", _flat(self.base), kinds)
+        base = _check_overrides("base", key_paths(self.base), kinds)
         for name in ("trials", "seed"):
             if getattr(self, name) is not None and name in base:
                 raise ValueError(f"base.{name}: {name} is already set at the top level of the sweep")
         if not isinstance(self.grid, Mapping):
             raise ValueError(f"grid: expected a table of field = [values], got {self.grid!r}")
         grid: dict[str, list[Any]] = {}
-        for name, values in _flat(self.grid).items():
+        for name, values in key_paths(self.grid).items():
             _check_name(f"grid.{name}", name, kinds)
             if isinstance(values, (str, bytes)) or not isinstance(values, Sequence):
                 raise ValueError(f"grid.{name}: expected a list of values, got {values!r}")
@@ -105,7 +105,7 @@ class Sweep:
             grid[name] = checked
         if isinstance(self.cells, (str, bytes, Mapping)) or not isinstance(self.cells, Sequence):
             raise ValueError(f"cells: expected a list of tables of overrides, got {self.cells!r}")
-        cells = [_check_overrides(f"cells[{i}]", _flat(c), kinds) for i, c in enumerate(self.cells)]
+        cells = [_check_overrides(f"cells[{i}]", key_paths(c), kinds) for i, c in enumerate(self.cells)]
         for i, cell in enumerate(cells):
             both = sorted(set(cell) & set(grid))
             if both:
@@ -216,20 +216,6 @@ def _task_kinds(experiment: str) -> dict[str, type]:
     and optional values are strings or numbers checked by the task itself (`object`)."""
     types = {"float": float, "int": int, "bool": bool, "str": str}
     return {e["key"]: types.get(e["kind"], object) for e in task_schema(experiment) if by_path(e)}
-
-
-def _flat(table: Any) -> Any:
-    """A table of overrides with nested task tables (``[grid.learner] alpha = …``) as key paths
-    (``learner.alpha``); anything else unchanged (checked where it is used)."""
-    if not isinstance(table, Mapping):
-        return table
-    out: dict[str, Any] = {}
-    for key, value in table.items():
-        if isinstance(value, Mapping):
-            out.update({f"{key}.{k}": v for k, v in _flat(value).items()})
-        else:
-            out[key] = value
-    return out
 
 
 def _check_name(where: str, name: str, kinds: Mapping[str, type]) -> None:
