@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from latentrl import cli
+from latentrl import LatentPolicy, cli
 
 from learning import CONTROL_ALPHA, assert_separated
 
@@ -123,3 +123,15 @@ def test_demos_of_another_robot_are_refused_by_column(tmp_path):
     result = latentrl(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(csv), "--out", str(tmp_path / "o"),
                        "--learner.gamma", "1.5"])
     assert result.returncode == 1 and "learner.gamma must lie in [0, 1), got 1.5" in result.stderr
+
+
+def test_a_task_with_move_corrections_trains_draws_and_saves(tmp_path):
+    out = tmp_path / "out"
+    result = latentrl(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--out", str(out),
+                       "--quick", "--trials", "1", "--episodes", "5", "--test-episodes", "1", "--no-progress",
+                       "--learner.move-correction", "true"])
+    assert result.returncode == 0, result.stderr
+    assert (out / "value_before.png").is_file() and (out / "value_after.png").is_file()
+    policy = LatentPolicy.load(out / "policy.npz")
+    grid = policy.task.to_dict()["learner"]["rbf_per_dim"] ** 2
+    assert policy.weights.shape == (1, grid * (1 + 8))  # V, then one correction per action

@@ -36,8 +36,7 @@ def figures(run: TrainRun, arrays: Mapping[str, np.ndarray], run_dir: Path, out:
     if model.n_components_ != 2 or "latent_weights" not in arrays:
         return
     low, high = latent_box(model.Z_, run.latent_margin)
-    before = np.full(int(learner["rbf_per_dim"]) ** 2, float(learner["initial_weight"]))
-    for name, weights in (("value_before", before), ("value_after", np.asarray(arrays["latent_weights"])[0])):
+    for name, weights in (("value_before", None), ("value_after", np.asarray(arrays["latent_weights"])[0])):
         fig, ax = plt.subplots(figsize=(6, 5))
         latent_value_panel(ax, weights, low, high, model, learner=learner)
         ax.set_title(f"{task.name}: value function {name.split('_')[1]} learning")
