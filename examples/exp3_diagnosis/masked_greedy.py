@@ -31,6 +31,9 @@ low, high = fitted.low, fitted.high
 steps = learner["step"] * (high - low) / (learner["rbf_per_dim"] - 1)
 if learner["actions"] != "axes_and_diagonals":
     raise SystemExit("this script knows the 8 axes-and-diagonals actions only")
+if learner["move_correction"]:
+    raise SystemExit("its masked look-ahead is V's alone (Eq. 11): a run with learner.move_correction would be compared "
+                     "with another policy")
 plant, judge = task.plant(fitted.demos), task.plant(fitted.demos)
 decode = fitted.model.inverse_transform
 

@@ -61,13 +61,16 @@ def key_paths(table: Any) -> Any:
     return out
 
 
+def ran_with(recorded: Mapping[str, Any]) -> dict[str, Any]:
+    """The task a run recorded (`Task.to_dict()` then) by key path, with every settable key the
+    record lacks (added since) at its default: the behaviour before the key existed."""
+    return {**{e["key"]: e["default"] for e in schema() if by_path(e)}, **key_paths(recorded)}
+
+
 def changed_since(recorded: Mapping[str, Any], now: Mapping[str, Any]) -> dict[str, Any]:
-    """The keys (by path) whose value a run recorded in its task (`Task.to_dict()` then) differs
-    from the task `now`'s, with the recorded values; a settable key the record lacks (added
-    since) counts at its default, the behaviour before it existed."""
-    given = key_paths(recorded)
-    ran = {**{e["key"]: e["default"] for e in schema() if by_path(e)}, **given}
-    now = key_paths(now)
+    """The keys (by path) whose value in the task a run recorded (`ran_with`) differs from the
+    task `now`'s, with the recorded values."""
+    given, ran, now = key_paths(recorded), ran_with(recorded), key_paths(now)
     return {k: v for k, v in ran.items() if (k in now and now[k] != v) or (k in given and k not in now)}
 
 

@@ -83,21 +83,26 @@ impl TdLearner {
         features.dot(&self.weights)
     }
 
+    /// Where in the weights the correction block `c_a` of `action` lies (past their end
+    /// without corrections).
+    #[inline]
+    fn block(&self, action: usize) -> std::ops::Range<usize> {
+        let start = self.n_features * (1 + action);
+        start..start + self.n_features
+    }
+
     /// The correction `C_a = c_aᵀ b` of block `action` (0 without corrections).
     #[inline]
     pub fn correction(&self, features: &SparseFeatures, action: usize) -> f64 {
-        let start = self.n_features * (1 + action);
-        self.weights
-            .get(start..start + self.n_features)
-            .map_or(0.0, |c| features.dot(c))
+        self.weights.get(self.block(action)).map_or(0.0, |c| features.dot(c))
     }
 
     /// `c_a ← c_a + α · error · b`, `error` being the TD target minus the look-ahead `Q(z, a)`;
     /// nothing without corrections.
     #[inline]
     pub fn correct(&mut self, features: &SparseFeatures, action: usize, error: f64) {
-        let start = self.n_features * (1 + action);
-        if let Some(c) = self.weights.get_mut(start..start + self.n_features) {
+        let block = self.block(action);
+        if let Some(c) = self.weights.get_mut(block) {
             let step = self.alpha * error;
             for (&i, &b) in features.indices.iter().zip(&features.values) {
                 c[i] += step * b;

@@ -20,7 +20,7 @@ import numpy as np
 from latentrl.progress import progress_bar
 
 from latentrl._base import read_npz
-from latentrl.task import changed_since, end_reasons, key_paths
+from latentrl.task import changed_since, end_reasons, ran_with
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
     as_saved,
@@ -266,7 +266,8 @@ def _previous(
     if not meta_path.exists():
         return {}, None
     meta = read_json(meta_path)
-    ran = key_paths(meta.get("setup", {}).get("task") or {})
+    recorded = meta.get("setup", {}).get("task")
+    ran = ran_with(recorded) if recorded is not None else {}
     if _edited(meta.get("preset") or {}, as_saved(plan), ran):
         raise ValueError(
             f"{meta_path.parent} holds a run of a different preset; choose another --out "
@@ -286,11 +287,11 @@ results.json whose preset was edited since."""
 
 def _edited(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any]) -> list[str]:
     """The preset fields that differ between `saved` and `now`. A task override that only
-    restores what the trials ran with (`ran`: the recorded task by key path, empty if none was
-    recorded; a key added since is not in it) is not an edit: `cli.saved_run` adds those when a shipped task changed since."""
+    restores what the trials ran with (`ran`: `task.ran_with` of the recorded task, empty if none
+    was recorded) is not an edit: `cli.saved_run` adds those when a shipped task changed since."""
     edited = [k for k in set(saved) | set(now) if k != "task" and saved.get(k) != now.get(k)]
     before, after = saved.get("task") or {}, now.get("task") or {}
-    restored = {k for k in set(after) - set(before) if (k in ran and ran[k] == after[k]) or (ran and k not in ran)}
+    restored = {k for k in set(after) - set(before) if k in ran and ran[k] == after[k]}
     if {k for k in set(before) | set(after) if before.get(k) != after.get(k)} - restored:
         edited.append("task")
     return sorted(edited)
