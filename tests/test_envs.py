@@ -289,3 +289,16 @@ def test_record_video_writes_an_episode_of_every_env(env_id, tmp_path):
     frames = iio.imread(videos[0])
     assert frames.shape[0] == 4 and frames.shape[3] == 3
     assert frames.std() > 0  # a picture, not a blank frame
+
+
+def test_a_success_truncates_and_does_not_terminate():
+    """Issue #41: with `target.hold_steps` an episode held at the target ends as a success,
+    which Gymnasium's API calls truncated (over, but not a terminal state: bootstrap it)."""
+    task = Task.shipped("two_arms").replace({"target.reach_radius": 100.0, "target.hold_steps": 2})
+    env = TaskEnv(task, demos=shipped_demos("two_arms"))
+    env.reset(seed=0)
+    zero = np.zeros(env.action_space.shape)
+    _, _, terminated, truncated, info = env.step(zero)
+    assert not terminated and not truncated and info == {"end_reason": None, "reached": True}
+    _, _, terminated, truncated, info = env.step(zero)
+    assert not terminated and truncated and info == {"end_reason": "success", "reached": True}

@@ -81,9 +81,10 @@ def test_a_saved_policy_loads_acts_and_rolls_out_the_same(arms_model: GPLVM, tmp
     np.testing.assert_array_equal(loaded.act(posture, trial=1), policy.act(posture, trial=1))
     once, again = policy.rollout(4, seed=2), loaded.rollout(4, seed=2)
     np.testing.assert_array_equal(once["returns"], again["returns"])
-    assert once["returns"].shape == (2, 4) and 0.0 <= once["summary"]["reached"] <= 1.0
+    assert once["returns"].shape == (2, 4) and 0.0 <= once["summary"]["reached_any_step"] <= 1.0
+    assert once["summary"]["success"] is None  # the task has no success rule (target.hold_steps = 0)
     assert sum(once["summary"]["ends"].values()) == 8
-    drawn = [loaded.rollout(4, seed=s, softmax=True) for s in (2, 2, 3)]
+    drawn = [loaded.rollout(4, seed=s, policy="softmax") for s in (2, 2, 3)]
     np.testing.assert_array_equal(drawn[0]["returns"], drawn[1]["returns"])
     assert drawn[0]["returns"].shape == (2, 4) and not np.array_equal(drawn[0]["returns"], once["returns"])
     assert drawn[0]["paths"].shape[:2] == once["paths"].shape[:2] == (2, 4)
@@ -93,6 +94,29 @@ def test_a_saved_policy_loads_acts_and_rolls_out_the_same(arms_model: GPLVM, tmp
     assert target.shape == (4,) and np.isfinite(target).all()
     with pytest.raises(ValueError, match=r"posture: expected shape \(4,\), got \(3,\)"):
         policy.act(posture[:3])
+
+
+def test_rollouts_start_where_the_tests_start_and_share_their_starts(arms_model: GPLVM) -> None:
+    """Issue #41: `rollout` draws its starts as the task's frozen tests do (Exp 2's: both hands
+    below the wall, `episode.test_start = "below_waypoint"`), or with starts="train" as its
+    training episodes; greedy, soft-max and the random control meet the same starts."""
+    policy = train_latent_policy(arms_model, trials=1, episodes=2, overrides={"episode.max_steps": 5}, test_episodes=0)
+    below = policy.task.to_dict()["waypoint"]["below"]
+    hands_y = policy.task.row_slices()["effectors"]
+
+    def start_heights(**kwargs: str) -> np.ndarray:
+        paths = policy.rollout(20, seed=1, **kwargs)["paths"][0]
+        return paths[:, 0, hands_y].reshape(20, -1, 3)[:, :, 1]
+
+    tested = start_heights()
+    assert (tested < below).all()
+    assert (start_heights(starts="train") >= below).any()
+    for kind in ("softmax", "random"):
+        np.testing.assert_array_equal(start_heights(policy=kind), tested)
+    with pytest.raises(ValueError, match=r"policy must be one of \['greedy', 'softmax', 'random'\], got 'best'"):
+        policy.rollout(1, policy="best")
+    with pytest.raises(ValueError, match="starts must be 'test' or 'train'"):
+        policy.rollout(1, starts="demo")
 
 
 def test_a_policy_file_is_checked(arms_model: GPLVM, tmp_path: Path) -> None:

@@ -98,7 +98,8 @@ class TaskEnv(gym.Env[Obs, Obs]):
     Terminated (with the penalty) when a step breaks a rule of the task: `info["end_reason"]` is
     "obstacle", "fall", "drop" (a constraint) or "box_exit"; `info["reached"]` says whether the
     effectors are within the target's reach radius. Truncated by the registration's
-    `max_episode_steps` (the task's `episode.max_steps`).
+    `max_episode_steps` (the task's `episode.max_steps`), and with `info["end_reason"]`
+    "success" when the task's `target.hold_steps` held (not a terminal state: bootstrap it).
 
     ## Arguments
     `task` (a Task or a shipped task's name), `demos` (N, D; default: the shipped demos of a
@@ -181,11 +182,14 @@ class TaskEnv(gym.Env[Obs, Obs]):
 
     def step(self, action: Obs) -> tuple[Obs, SupportsFloat, bool, bool, dict[str, Any]]:
         """Moves the servo targets by `action` (clipped to ±`max_step`) and runs one RL step;
-        returns observation, reward, terminated (a rule broken), truncated (never) and info
+        returns observation, reward, terminated (a rule broken), truncated (a success of the
+        task's `target.hold_steps`: the episode is over, the state is not terminal) and info
         (``end_reason``, ``reached``)."""
         delta = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
         reward, end, _ = self.plant.step(self.action_origin + delta)
-        return self._obs(), float(reward), end is not None, False, _info(end, self.plant.reached())
+        success = end is not None and end_reasons()[end] == "success"
+        info = _info(end, self.plant.reached())
+        return self._obs(), float(reward), end is not None and not success, success, info
 
     def render(self) -> NDArray[np.uint8] | None:
         """An RGB image (H, W, 3) of the robot's links, the target and the floor if `render_mode`

@@ -123,6 +123,24 @@ def train_latent_policy(
     )
 
 
+POLICIES = ("greedy", "softmax", "random")
+"""How a rollout acts: greedily, by the learner's soft-max, or uniformly at random (the control)."""
+
+
+def rollout_summary(ends: NDArray[Any], reached: NDArray[Any], returns: NDArray[Any], task: Task) -> dict[str, Any]:
+    """What rollout episodes of `task` did: "success" (the share that ended as the task's
+    success, `target.hold_steps`; None where the task has no such rule), "reached_any_step" (the
+    share within the reach radius after some step), the count of each ending, the mean return."""
+    names = end_reasons()
+    rule = task.to_dict()["target"]["hold_steps"] > 0
+    return {
+        "success": float((ends == names.index("success")).mean()) if rule else None,
+        "reached_any_step": float(reached.mean()),
+        "ends": {names[c]: int((ends == c).sum()) for c in range(len(names))},
+        "mean_return": float(returns.mean()),
+    }
+
+
 RECORD = ("returns", "ends", "reached", "test_returns", "test_ends", "test_reached")
 """What a policy keeps of its training: per episode and per frozen test episode, each (trials, episodes)."""
 
@@ -184,47 +202,37 @@ class LatentPolicy:
             raise ValueError(f"trial must be an int in 0..{len(self._native) - 1}, got {trial!r}")
         return self._native[int(trial)]
 
-    def rollout(self, episodes: int = 20, *, trial: int | None = None, seed: int = 0, softmax: bool = False,
-                progress: Any = None) -> dict[str, Any]:
-        """Runs the policy (no learning) for `episodes` episodes per trial (every trial, or
-        `trial`) from the task's start rule; returns the native dict (returns, ends, reached,
-        trajectories of the first 20 episodes, …) plus "reached" as the fraction and "ends" as
-        counts per ending in "summary". The policy is greedy (what `act` does), or with
-        `softmax` draws each action from the learner's soft-max on the learnt V, as a run's
-        frozen test episodes do (on Exp 3 the greedy policy lifts from fewer starts:
-        docs/exp3.md); those episodes follow one greedy episode, which the native runner needs."""
+    def rollout(self, episodes: int = 20, *, trial: int | None = None, seed: int = 0, policy: str = "greedy",
+                starts: str = "test", progress: Any = None) -> dict[str, Any]:
+        """Runs the policy frozen (no learning) for `episodes` episodes per trial (every trial, or
+        `trial`); returns the native dict (returns, ends, reached, paths of the first 20
+        episodes) plus a "summary" (`rollout_summary`).
+
+        `policy`: ``"greedy"`` (what `act` does), ``"softmax"`` (draws from the learner's soft-max
+        on the learnt V, as a run's frozen tests do; on Exp 3 the greedy policy lifts from fewer
+        starts: docs/exp3.md) or ``"random"``, the control: each move uniformly at random, which
+        cannot learn by construction. `starts`: ``"test"`` draws them as the task's frozen tests
+        do (`episode.test_start`), ``"train"`` as its training episodes. Each episode draws from
+        its own generator of (`seed`, trial, episode), so the three policies meet the same starts."""
+        if policy not in POLICIES:
+            raise ValueError(f"policy must be one of {list(POLICIES)}, got {policy!r}")
+        if starts not in ("test", "train"):
+            raise ValueError(f"starts must be 'test' or 'train', got {starts!r}")
         trials = range(len(self.weights)) if trial is None else [self._check_trial(trial)]
-        task = self.task.replace({"episode.test_start": "any"}) if softmax else self.task
         recorded = list(range(min(episodes, 20)))
-        runs = []
-        for t in trials:
-            run = _native.run_task_trials(
-                task._native, decoder=self.model.decoder_, encoder=self.model.loop_encoder_,
+        runs = [
+            _native.run_task_trials(
+                self.task._native, decoder=self.model.decoder_, encoder=self.model.loop_encoder_,
                 latent_low=self.latent_low, latent_high=self.latent_high, demos=self.demos, n_trials=1,
-                episodes=1 if softmax else episodes, base_seed=seed, first_trial=t, weights=self.weights[t],
-                rollout=True, record_episodes=[] if softmax else recorded,
-                test_episodes=episodes if softmax else 0, record_test_episodes=recorded if softmax else [],
-                progress=progress,
+                episodes=episodes, base_seed=seed, first_trial=t, weights=self.weights[t],
+                rollout=policy, test_starts=starts == "test", record_episodes=recorded, progress=progress,
             )
-            if softmax:
-                run.update(returns=run["test_returns"], ends=run["test_ends"], reached=run["test_reached"],
-                           trajectories=run["test_trajectories"])
-            runs.append(run)
-        ends = np.concatenate([r["ends"] for r in runs])
-        reached = np.concatenate([r["reached"] for r in runs])
-        names = end_reasons()
-        return {
-            "trials": list(trials),
-            "returns": np.concatenate([r["returns"] for r in runs]),
-            "ends": ends,
-            "reached": reached,
-            "paths": np.concatenate([r["trajectories"] for r in runs]),
-            "summary": {
-                "reached": float(reached.mean()),
-                "ends": {names[c]: int((ends == c).sum()) for c in range(len(names))},
-                "mean_return": float(np.concatenate([r["returns"] for r in runs]).mean()),
-            },
-        }
+            for t in trials
+        ]
+        result = {key: np.concatenate([r[key] for r in runs]) for key in ("returns", "ends", "reached")}
+        result["paths"] = np.concatenate([r["trajectories"] for r in runs])
+        return {"trials": list(trials), **result, "summary": rollout_summary(result["ends"], result["reached"],
+                                                                             result["returns"], self.task)}
 
     def _check_trial(self, trial: int) -> int:
         self._policy(trial)

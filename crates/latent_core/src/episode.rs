@@ -11,16 +11,17 @@
 //! 5. encode `z_{t+1} = g(x̃)`;
 //! 6. TD(0) on `(z_t, r_t, z_{t+1})` (Eq. 7–9), terminal if the plant ended the episode
 //!    (skipped in [`Phase::Test`] and [`Phase::Rollout`]: they act on the learnt V unchanged;
-//!    a rollout takes the greedy action in step 1).
+//!    a rollout takes its action by its [`ActionRule`] in step 1).
 //!
 //! Steps 2–5 are [`transition`], which an environment stepping a latent point by any delta
 //! (Gymnasium's latent-space wrapper) shares. Reaching `max_steps` is a time-out, not a
-//! terminal state: the last update bootstraps.
+//! terminal state: the last update bootstraps; so does a plant's success
+//! ([`EndReason::is_terminal`]).
 
 use rand::{Rng, RngExt};
 
 use crate::error::{CoreError, Result};
-use crate::learner::{Learner, Phase, StartMode, greedy};
+use crate::learner::{ActionRule, Learner, StartMode, greedy};
 use crate::plant::{EndReason, Plant};
 use crate::rbf::{RbfScratch, SparseFeatures};
 use crate::space::{SpaceScratch, StateSpace};
@@ -107,8 +108,8 @@ pub fn refused(z_target: &[f64], bounds: &Bounds<'_>, variance: Option<f64>) -> 
 }
 
 /// Steps 2–5 of the module docs towards the latent target `z_target`: box check, decode (and
-/// gate), one plant step, and — unless the plant ended the episode — encode the reached
-/// posture into `s.next`.
+/// gate), one plant step, and — unless the plant ended the episode in a terminal state —
+/// encode the reached posture into `s.next`.
 #[inline]
 pub fn transition<P: Plant>(
     plant: &mut P,
@@ -131,7 +132,7 @@ pub fn transition<P: Plant>(
         return refusal(end);
     }
     let outcome = plant.step(&s.target, &mut s.reached);
-    if outcome.end.is_none() {
+    if outcome.end.is_none_or(|e| !e.is_terminal()) {
         space.encode(&s.reached, &mut s.next, &mut s.maps);
     }
     StepResult {
@@ -212,7 +213,8 @@ impl Learner {
     }
 
     /// Starts an episode (see [`StartMode`]): resets the plant and sets `z_0` and `b(z_0)`.
-    /// In [`Phase::Test`] a start must also pass [`Plant::admits_test_start`].
+    /// In [`Phase::Test`] (and a rollout from test starts) a start must also pass
+    /// [`Plant::admits_test_start`].
     pub fn start<P: Plant, R: Rng + ?Sized>(
         &self,
         plant: &mut P,
@@ -242,7 +244,7 @@ impl Learner {
                     admitted = !gated && plant.reset(&t.reached).is_none();
                 }
             }
-            if admitted && (self.phase != Phase::Test || plant.admits_test_start()) {
+            if admitted && (!self.phase.test_starts() || plant.admits_test_start()) {
                 break;
             }
             admitted = false;
@@ -267,20 +269,20 @@ impl Learner {
         let dim = self.grid.dim();
         // 1. Look-ahead Q(z, u_i) = V(z + Δ_i) (Eq. 11) and soft-max draw (Eq. 10).
         self.look_ahead(&s.z, &s.current, &mut s.candidate, &mut s.q, &mut s.rbf);
-        let a = if self.phase == Phase::Rollout {
-            greedy(&s.q)
-        } else {
-            self.policy.sample(&s.q, &mut s.q_buffer, rng)
+        let a = match self.phase.action() {
+            ActionRule::Greedy => greedy(&s.q),
+            ActionRule::SoftMax => self.policy.sample(&s.q, &mut s.q_buffer, rng),
+            ActionRule::Random => rng.random_range(0..self.n_actions),
         };
         // 2.–5. z' = z + Δ_a, box, decode, plant, encode.
         shifted(&s.z, &self.displacements[a * dim..(a + 1) * dim], &mut s.candidate);
         let result = transition(plant, space, &self.bounds(), &s.candidate, &mut s.step);
         let q = s.q[a];
-        if result.end.is_some() {
+        if result.end.is_some_and(EndReason::is_terminal) {
             self.learn(&s.current, a, q, result.reward, None);
             return result;
         }
-        // 6. TD(0) with bootstrap.
+        // 6. TD(0) with bootstrap (also from a success, which ends the episode).
         self.grid.eval_into(&s.step.next, &mut s.rbf, &mut s.next);
         let v_next = self.td.value(&s.next);
         self.learn(&s.current, a, q, result.reward, Some(v_next));
@@ -352,7 +354,7 @@ fn shifted(z: &[f64], d: &[f64], out: &mut [f64]) {
 mod tests {
     use super::*;
     use crate::config::LearnerConfig;
-    use crate::learner::EpisodeRules;
+    use crate::learner::{EpisodeRules, Phase};
     use crate::plant::StepOutcome;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
@@ -566,6 +568,75 @@ mod tests {
         assert!(
             corrected < 5 && corrected_greedy < 0.49,
             "with corrections: {corrected} hits, greedy to {corrected_greedy}"
+        );
+    }
+
+    /// A 1-D line from 0.3: reward 0.1 per step below 0.8, 1 at or above it, where the
+    /// episode ends as `end`.
+    struct Goal {
+        x: f64,
+        end: EndReason,
+    }
+
+    impl Plant for Goal {
+        fn posture_dim(&self) -> usize {
+            1
+        }
+        fn task_dim(&self) -> usize {
+            1
+        }
+        fn sample_start<R: Rng + ?Sized>(&mut self, _rng: &mut R, posture: &mut [f64]) {
+            posture[0] = 0.3;
+        }
+        fn reset(&mut self, posture: &[f64]) -> Option<EndReason> {
+            self.x = posture[0];
+            None
+        }
+        fn step(&mut self, target: &[f64], reached: &mut [f64]) -> StepOutcome {
+            self.x = target[0];
+            reached[0] = self.x;
+            let at_goal = self.x >= 0.8;
+            StepOutcome {
+                reward: if at_goal { 1.0 } else { 0.1 },
+                end: at_goal.then_some(self.end),
+            }
+        }
+        fn task_position(&self, out: &mut [f64]) {
+            out[0] = self.x;
+        }
+    }
+
+    #[test]
+    fn a_success_bootstraps_so_the_learner_seeks_it() {
+        // Ended as a terminal state the goal is worth its one reward (1) against 0.1 / (1 − γ)
+        // = 2 for staying away, so the learner learns to avoid it; a success bootstraps
+        // (optimistic w₀ = 1 / (1 − γ) for exploration, as in the quick presets). Measured:
+        // 100 of the last 100 episodes end at the goal as a success, 1 as a terminal end.
+        let goals = |end| {
+            let config = LearnerConfig {
+                rbf_per_dim: 11,
+                alpha: 0.5,
+                step: 1.0,
+                initial_weight: 20.0,
+                ..LearnerConfig::default()
+            };
+            let mut l = Learner::new(&config, rules(40, StartMode::Plant), &[0.0], &[1.0]).unwrap();
+            let mut plant = Goal { x: 0.0, end };
+            let mut rng = ChaCha8Rng::seed_from_u64(2);
+            let mut s = l.scratch(&StateSpace::Full, 1);
+            let ends: Vec<EndReason> = (0..400)
+                .map(|_| {
+                    l.run_episode(&mut plant, &StateSpace::Full, &mut rng, &mut s, None)
+                        .unwrap()
+                        .end
+                })
+                .collect();
+            ends[300..].iter().filter(|&&e| e == end).count()
+        };
+        let (success, terminal) = (goals(EndReason::Success), goals(EndReason::Obstacle));
+        assert!(
+            success > 80 && terminal < 50,
+            "goal reached in the last 100 episodes: {success} as a success, {terminal} as a terminal end"
         );
     }
 

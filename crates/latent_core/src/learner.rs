@@ -48,6 +48,20 @@ impl Default for EpisodeRules {
     }
 }
 
+crate::choice! {
+    /// How a frozen learner picks each action.
+    pub enum ActionRule {
+        /// The action of the largest look-ahead value, the first of equals.
+        Greedy = "greedy",
+        /// A draw from the soft-max on the look-ahead values (Eq. 10), as in training.
+        SoftMax = "softmax",
+        /// One of the actions uniformly at random, whatever the weights: a control that cannot
+        /// learn by construction (the untrained learner's soft-max is the same draw only where
+        /// V is flat, and a greedy one on near-equal weights resolves rounding noise).
+        Random = "random",
+    }
+}
+
 /// Whether a learner is training, running frozen test episodes, or rolling out its policy.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Phase {
@@ -57,15 +71,33 @@ pub enum Phase {
     /// No updates: the soft-max policy acts on the learnt value function as it is, and
     /// starts must also pass [`crate::Plant::admits_test_start`] (SPEC §4.2's frozen tests).
     Test,
-    /// No updates and the greedy policy: the action of the largest look-ahead value (the
-    /// first of equals); starts as in training. What a saved policy does when it is run.
-    Rollout,
+    /// No updates, actions by `action`; starts as the frozen tests' (`test_starts`) or as
+    /// training's. What a saved policy does when it is run, and its control.
+    Rollout {
+        /// How each action is chosen.
+        action: ActionRule,
+        /// Whether starts must also pass [`crate::Plant::admits_test_start`].
+        test_starts: bool,
+    },
 }
 
 impl Phase {
     /// Whether TD(0) updates the weights.
     pub fn learns(self) -> bool {
         self == Phase::Train
+    }
+
+    /// Whether a start must also pass [`crate::Plant::admits_test_start`].
+    pub fn test_starts(self) -> bool {
+        matches!(self, Phase::Test | Phase::Rollout { test_starts: true, .. })
+    }
+
+    /// How actions are chosen.
+    pub fn action(self) -> ActionRule {
+        match self {
+            Phase::Train | Phase::Test => ActionRule::SoftMax,
+            Phase::Rollout { action, .. } => action,
+        }
     }
 }
 

@@ -29,7 +29,7 @@ pub use error::{CoreError, Result};
 pub use gp::{GpMap, PredictScratch};
 pub use gplvm::{NllGrad, nll_grad};
 pub use kernel::{Factor, SeKernel, factorize};
-pub use learner::{EpisodeRules, Learner, Phase, StartMode};
+pub use learner::{ActionRule, EpisodeRules, Learner, Phase, StartMode};
 pub use params::{Check, FieldInfo, Kind, ParamError, Params, Rule};
 pub use plant::{EndReason, Plant, StepOutcome};
 pub use policy::SoftmaxPolicy;

@@ -420,6 +420,14 @@ macro_rules! choice {
                     $(Self::$variant => $text,)*
                 }
             }
+
+            /// The choice written `name`, if it is one.
+            pub fn from_name(name: &str) -> Option<Self> {
+                match name {
+                    $($text => Some(Self::$variant),)*
+                    _ => None,
+                }
+            }
         }
 
         impl $crate::params::Check for $name {
@@ -558,5 +566,7 @@ mod tests {
         assert_eq!(fields[5].kind, "red | dark_blue");
         assert_eq!(fields[6].kind, "list of table");
         assert_eq!(Colour::DarkBlue.as_str(), "dark_blue");
+        assert_eq!(Colour::from_name("dark_blue"), Some(Colour::DarkBlue));
+        assert_eq!(Colour::from_name("DarkBlue"), None);
     }
 }

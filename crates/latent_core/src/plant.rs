@@ -20,20 +20,27 @@ pub enum EndReason {
     Fall = 4,
     /// 5 `variance_gate`: variance gating (SPEC §3.2) refused a decoded target; ours, beyond SPEC §5.
     VarianceGate = 5,
+    /// 6 `success`: the plant's own success rule held (a task's `target.hold_steps`: within
+    /// the reach radius that many steps running). The episode ends but the state is not
+    /// terminal: its last update bootstraps, as a time-out's does, so V keeps valuing the
+    /// target (a terminal success would teach the learner to avoid finishing).
+    Success = 6,
 }
 
 impl EndReason {
     /// Every reason, in code order.
-    pub const ALL: [EndReason; 6] = [
+    pub const ALL: [EndReason; 7] = [
         Self::TimeOut,
         Self::Obstacle,
         Self::BoxExit,
         Self::Drop,
         Self::Fall,
         Self::VarianceGate,
+        Self::Success,
     ];
 
-    /// The numeric code (0 time-out, 1 obstacle, 2 box exit, 3 drop, 4 fall, 5 variance gate).
+    /// The numeric code (0 time-out, 1 obstacle, 2 box exit, 3 drop, 4 fall, 5 variance gate,
+    /// 6 success).
     pub fn code(self) -> u8 {
         self as u8
     }
@@ -52,7 +59,14 @@ impl EndReason {
             Self::Drop => "drop",
             Self::Fall => "fall",
             Self::VarianceGate => "variance_gate",
+            Self::Success => "success",
         }
+    }
+
+    /// Whether the state it ends in is terminal (its update does not bootstrap): every ending
+    /// but a time-out and a success.
+    pub fn is_terminal(self) -> bool {
+        !matches!(self, Self::TimeOut | Self::Success)
     }
 }
 
@@ -61,7 +75,8 @@ impl EndReason {
 pub struct StepOutcome {
     /// Reward of the reached state (Eq. 12), the plant's penalty already added if it ended.
     pub reward: f64,
-    /// `Some(reason)` if this step ended the episode (a terminal transition).
+    /// `Some(reason)` if this step ended the episode (a terminal transition unless
+    /// [`EndReason::is_terminal`] says otherwise).
     pub end: Option<EndReason>,
 }
 
@@ -113,14 +128,24 @@ mod tests {
 
     #[test]
     fn end_codes_and_names_round_trip() {
-        for code in 0..6u8 {
+        for code in 0..7u8 {
             assert_eq!(EndReason::from_code(code).unwrap().code(), code);
         }
-        assert!(EndReason::from_code(6).is_none());
+        assert!(EndReason::from_code(7).is_none());
         let names: Vec<_> = EndReason::ALL.iter().map(|e| e.name()).collect();
         assert_eq!(
             names,
-            ["timeout", "obstacle", "box_exit", "drop", "fall", "variance_gate"]
+            [
+                "timeout",
+                "obstacle",
+                "box_exit",
+                "drop",
+                "fall",
+                "variance_gate",
+                "success"
+            ]
         );
+        let terminal: Vec<_> = EndReason::ALL.iter().map(|e| e.is_terminal()).collect();
+        assert_eq!(terminal, [false, true, true, true, true, true, false]);
     }
 }

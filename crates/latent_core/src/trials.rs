@@ -35,6 +35,19 @@ pub fn trial_rng(base_seed: u64, trial: usize) -> ChaCha8Rng {
     rng
 }
 
+/// The generator of rollout episode `episode` of trial `trial`: ChaCha8 seeded from the three
+/// indices. A rollout draws each episode's start, then its actions, from its own generator, so
+/// every policy rolled out with the same seed (greedy, soft-max, the random control) meets the
+/// same starts, whatever the actions before consumed.
+pub fn episode_rng(base_seed: u64, trial: usize, episode: usize) -> ChaCha8Rng {
+    let mut seed = [0u8; 32];
+    seed[..8].copy_from_slice(&base_seed.to_le_bytes());
+    seed[8..16].copy_from_slice(&(trial as u64).to_le_bytes());
+    seed[16..24].copy_from_slice(&(episode as u64).to_le_bytes());
+    seed[24..].copy_from_slice(b"rollout\0");
+    ChaCha8Rng::from_seed(seed)
+}
+
 /// What to run; `Default` is one trial of 5000 episodes (paper Exp. 1 length) from seed 0.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct TrialOptions {
@@ -56,7 +69,7 @@ pub struct TrialOptions {
     /// Test-episode indices (0-based) whose task-space trajectory is recorded.
     pub record_test_episodes: Vec<usize>,
     /// The phase of the `episodes` ([`Phase::Train`]; [`Phase::Rollout`] runs a trained
-    /// template's greedy policy).
+    /// template's policy frozen, each episode from its [`episode_rng`]).
     pub phase: Phase,
 }
 
@@ -237,10 +250,12 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
     learner.set_phase(options.phase);
     let scratch = learner.scratch(space, plant.posture_dim());
     let rng = trial_rng(options.base_seed, trial);
+    let rollout = matches!(options.phase, Phase::Rollout { .. });
     let mut run = TrialRun {
         plant,
         learner,
         rng,
+        episode_seed: rollout.then_some((options.base_seed, trial)),
         scratch,
         space,
         cancel,
@@ -279,6 +294,8 @@ struct TrialRun<'a, P> {
     plant: P,
     learner: Learner,
     rng: ChaCha8Rng,
+    /// A rollout's seed and trial: each episode draws from its own [`episode_rng`].
+    episode_seed: Option<(u64, usize)>,
     scratch: EpisodeScratch,
     space: &'a StateSpace<'a>,
     cancel: &'a AtomicBool,
@@ -305,7 +322,15 @@ impl<P: Plant> TrialRun<'_, P> {
             if self.cancel.load(Ordering::Relaxed) {
                 return Ok((episodes, trajectories, false));
             }
-            let (plant, rng, space, scratch) = (&mut self.plant, &mut self.rng, self.space, &mut self.scratch);
+            let mut own;
+            let rng = match self.episode_seed {
+                Some((seed, trial)) => {
+                    own = episode_rng(seed, trial, e);
+                    &mut own
+                }
+                None => &mut self.rng,
+            };
+            let (plant, space, scratch) = (&mut self.plant, self.space, &mut self.scratch);
             let rec = if starts.is_some() || record.contains(&e) {
                 buffer.clear();
                 self.learner
@@ -343,6 +368,94 @@ mod tests {
         assert!(a.windows(2).all(|w| w[0] == w[1]));
         assert_ne!(trial_rng(1, 0).next_u64(), trial_rng(1, 1).next_u64());
         assert_ne!(trial_rng(1, 0).next_u64(), trial_rng(2, 0).next_u64());
+    }
+
+    /// A 1-D line: starts uniform in [0, 1], a test start below 0.5; the reward is x.
+    struct Line {
+        x: f64,
+    }
+
+    impl Plant for Line {
+        fn posture_dim(&self) -> usize {
+            1
+        }
+        fn task_dim(&self) -> usize {
+            1
+        }
+        fn sample_start<R: rand::Rng + ?Sized>(&mut self, rng: &mut R, posture: &mut [f64]) {
+            posture[0] = rand::RngExt::random_range(rng, 0.0..1.0);
+        }
+        fn reset(&mut self, posture: &[f64]) -> Option<crate::EndReason> {
+            self.x = posture[0];
+            None
+        }
+        fn step(&mut self, target: &[f64], reached: &mut [f64]) -> crate::StepOutcome {
+            self.x = target[0];
+            reached[0] = self.x;
+            crate::StepOutcome {
+                reward: self.x,
+                end: None,
+            }
+        }
+        fn task_position(&self, out: &mut [f64]) {
+            out[0] = self.x;
+        }
+        fn admits_test_start(&self) -> bool {
+            self.x < 0.5
+        }
+    }
+
+    #[test]
+    fn rollouts_of_every_action_rule_meet_the_same_starts() {
+        use crate::learner::ActionRule;
+        let config = crate::LearnerConfig {
+            rbf_per_dim: 11,
+            step: 1.0,
+            ..Default::default()
+        };
+        let rules = crate::EpisodeRules {
+            max_steps: 5,
+            ..Default::default()
+        };
+        let mut template = Learner::new(&config, rules, &[0.0], &[1.0]).unwrap();
+        // V rises to the right: greedy always moves right.
+        template
+            .set_weights(&(0..11).map(f64::from).collect::<Vec<_>>())
+            .unwrap();
+        let run = |action, test_starts, seed| {
+            let options = TrialOptions {
+                episodes: 30,
+                base_seed: seed,
+                record_episodes: (0..30).collect(),
+                phase: Phase::Rollout { action, test_starts },
+                ..Default::default()
+            };
+            let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
+            let plant = |_| Ok(Line { x: 0.0 });
+            let trial = run_trials(&template, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
+            assert_eq!(template.weights(), &(0..11).map(f64::from).collect::<Vec<_>>()[..]);
+            trial.into_iter().next().unwrap().trajectories
+        };
+        let starts = |paths: &[Vec<f64>]| paths.iter().map(|p| p[0]).collect::<Vec<_>>();
+        let greedy = run(ActionRule::Greedy, false, 4);
+        let softmax = run(ActionRule::SoftMax, false, 4);
+        let random = run(ActionRule::Random, false, 4);
+        assert_eq!(starts(&greedy), starts(&softmax));
+        assert_eq!(starts(&greedy), starts(&random));
+        assert_ne!(starts(&greedy), starts(&run(ActionRule::Greedy, false, 5)));
+        assert!(
+            greedy.iter().all(|p| p.windows(2).all(|w| w[1] >= w[0])),
+            "greedy moves right"
+        );
+        let lefts = |paths: &[Vec<f64>]| paths.iter().flat_map(|p| p.windows(2)).filter(|w| w[1] < w[0]).count();
+        assert!(
+            lefts(&random) > 40,
+            "the random control ignores V: {} moves left",
+            lefts(&random)
+        );
+        let tested = run(ActionRule::Random, true, 4);
+        assert!(starts(&tested).iter().all(|&x| x < 0.5));
+        assert!(starts(&greedy).iter().any(|&x| x >= 0.5));
     }
 
     #[test]

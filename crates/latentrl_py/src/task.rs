@@ -8,8 +8,9 @@ use ::sim::task::{
     ConstraintConfig, FallConfig, FloorConfig, ObstacleConfig, Task, TaskConfig, TaskPlant, WaypointConfig,
 };
 use ::sim::world::JointServo;
+use latent_core::params::Kind;
 use latent_core::trials::LatentSpace;
-use latent_core::{EndReason, Learner, Phase, Plant, trial_rng};
+use latent_core::{ActionRule, EndReason, Learner, Phase, Plant, trial_rng};
 use nalgebra::DMatrix;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -367,7 +368,9 @@ impl PyTaskPlant {
 /// task: a Task. decoder: GpMap latent (d) → posture (D); encoder: GpMap or Projection
 /// posture → latent. latent_low, latent_high: (d,) corners of the latent box. demos: (N, D) demonstrations (a "demo" start
 /// uses row `episode.start_demo`). weights: (M,) value weights to start from (a saved policy;
-/// default w₀ everywhere). rollout: run the `episodes` frozen with the greedy policy.
+/// default w₀ everywhere). rollout: run the `episodes` frozen, each action "greedy", "softmax"
+/// or "random" (the control), each episode from its own generator (the same starts for each);
+/// test_starts: a rollout starts where the frozen tests do.
 /// n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
 /// record_test_episodes, return_weights, progress: as for run_bimanual_trials.
 ///
@@ -376,7 +379,7 @@ impl PyTaskPlant {
 #[pyfunction]
 #[pyo3(signature = (
     task, *, decoder, encoder, latent_low, latent_high, n_trials, episodes, base_seed, demos = None,
-    weights = None, rollout = false, first_trial = None, record_episodes = None, test_episodes = None,
+    weights = None, rollout = None, test_starts = false, first_trial = None, record_episodes = None, test_episodes = None,
     record_test_episodes = None, return_weights = false, progress = None,
 ))]
 #[allow(clippy::too_many_arguments)]
@@ -392,7 +395,8 @@ pub fn run_task_trials<'py>(
     base_seed: &Bound<'py, PyAny>,
     demos: Option<PyReadonlyArray2<'py, f64>>,
     weights: Option<PyReadonlyArray1<'py, f64>>,
-    rollout: bool,
+    rollout: Option<&str>,
+    test_starts: bool,
     first_trial: Option<&Bound<'py, PyAny>>,
     record_episodes: Option<&Bound<'py, PyAny>>,
     test_episodes: Option<&Bound<'py, PyAny>>,
@@ -404,8 +408,10 @@ pub fn run_task_trials<'py>(
         #[rustfmt::skip]
         let mut run = RunArgs { n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
                                 record_test_episodes, return_weights, progress }.check()?;
-        if rollout {
-            run.options.phase = Phase::Rollout;
+        if let Some(name) = rollout {
+            let action = ActionRule::from_name(name)
+                .ok_or_else(|| invalid(format!("rollout must be one of {}, got {name:?}", ActionRule::kind())))?;
+            run.options.phase = Phase::Rollout { action, test_starts };
         }
         let task = Arc::clone(&task.inner);
         let demos = rows("demos", demos)?;
@@ -547,7 +553,7 @@ pub fn bimanual_schema<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
     })
 }
 
-/// The end reasons by code: their names in results files (0 timeout … 5 variance_gate).
+/// The end reasons by code: their names in results files (0 timeout … 6 success).
 #[pyfunction]
 pub fn end_reasons() -> Vec<&'static str> {
     EndReason::ALL.iter().map(|e| e.name()).collect()

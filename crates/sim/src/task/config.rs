@@ -113,6 +113,11 @@ params! {
         theta: f64 = 0.35 => Rule::Positive,
         /// "Reached the target": RMS per-effector distance to h* at most this (m).
         reach_radius: f64 = 0.05 => Rule::Positive,
+        /// Success: an episode ends as `success` (code 6) once the effectors have stayed within
+        /// `reach_radius` for this many RL steps in a row (a place, not a pass); 0: never (the
+        /// paper's rule: episodes run on at the target to `episode.max_steps`). A success is not
+        /// a terminal state: its update bootstraps, so V keeps valuing the target.
+        hold_steps: usize = 0 => Rule::count(0, 1_000_000),
         /// A link from whose origin h and h* are measured (world axes), e.g. the standing sole:
         /// the target moves with the feet. Absent: world positions.
         relative_to: Option<String> = None => Rule::NonEmpty,

@@ -6,7 +6,9 @@
 //! the reached state, in this order: an obstacle touched (code 1), a fall (code 4), a
 //! constraint broken (code 3) end the episode with `reward + penalty` (with
 //! `episode.check_rules = "physics_step"`, also when one held after any physics step of it);
-//! the reward is `exp(−θ ‖(h − h*)/ℓ‖²)` over the effector positions h. The same rules
+//! the reward is `exp(−θ ‖(h − h*)/ℓ‖²)` over the effector positions h. Otherwise, with
+//! `target.hold_steps` set, the step that makes that many in a row within the reach radius
+//! ends it as a success (code 6, no penalty, not terminal). The same rules
 //! refuse a start at [`Plant::reset`], with a posture outside the joint limits (code 2) and, with a fall rule,
 //! a centre of mass outside the support (`fall.min_start_margin`) as well.
 //!
@@ -66,6 +68,8 @@ pub struct TaskPlant {
     home: Vec<f64>,
     started_below: bool,
     went_above: bool,
+    /// RL steps in a row, up to now, with the effectors within the reach radius.
+    held: usize,
 }
 
 impl TaskPlant {
@@ -177,6 +181,7 @@ impl TaskPlant {
             home,
             started_below: false,
             went_above: false,
+            held: 0,
         };
         if let Some(fall) = &plant.fall {
             plant.world.fall_status(fall)?;
@@ -396,6 +401,14 @@ impl TaskPlant {
             .then_some(EndReason::Drop)
     }
 
+    /// Counts the steps in a row within the reach radius; a success once `target.hold_steps`
+    /// (if set) are.
+    fn success(&mut self) -> Option<EndReason> {
+        let hold = self.task.config().target.hold_steps;
+        self.held = if self.reached_target() { self.held + 1 } else { 0 };
+        (hold > 0 && self.held >= hold).then_some(EndReason::Success)
+    }
+
     fn all_effectors(&self, test: impl Fn(f64) -> bool) -> bool {
         let axis = self.task.config().waypoint.as_ref().map_or(1, |w| w.axis.index());
         self.effectors.chunks_exact(3).all(|h| test(h[axis]))
@@ -441,6 +454,7 @@ impl Plant for TaskPlant {
             self.started_below = self.all_effectors(|v| v < below);
         }
         self.went_above = false;
+        self.held = 0;
         if let Some(end) = self.violation() {
             return Some(end);
         }
@@ -486,6 +500,7 @@ impl Plant for TaskPlant {
         }
         let end = end.or_else(|| self.violation());
         let reward = self.reward() + if end.is_some() { penalty } else { 0.0 };
+        let end = end.or_else(|| self.success());
         StepOutcome { reward, end }
     }
 
