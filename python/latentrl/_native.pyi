@@ -37,6 +37,7 @@ __all__ = [
     "run_task_trials",
     "task_schema",
     "urdf_info",
+    "demo_columns",
 ]
 
 __version__: str
@@ -415,13 +416,19 @@ def task_schema() -> list[dict[str, Any]]:
 def bimanual_schema() -> list[dict[str, Any]]:
     """The keys of Experiment 1's configuration (`plant.*`, `learner.*`), as `task_schema`."""
 
-def urdf_info(path: str | PathLike[str]) -> dict[str, Any]:
-    """Reads and checks a URDF file (meshes hulled, through the cache) and returns what it holds:
-    `{name, joints, links, collision, visual, total_mass}`; each joint a dict `{name, type,
+def urdf_info(path: str | PathLike[str], *, balance_inertia: bool = False) -> dict[str, Any]:
+    """Reads and checks a URDF file (meshes hulled, through the cache; inertias repaired with
+    `balance_inertia`) and returns what it holds: `{name, joints, links, collision, visual,
+    total_mass, warnings}` (warnings: what was repaired, one sentence each); each joint a dict `{name, type,
     lower, upper, effort, velocity, damping, friction, mimic}` (mimic: `{leader, multiplier,
     offset}` or None), actuated joints first in URDF order, then the mimic ones. Each shape a
     dict `{link, kind, size, origin, file, hull}` (origin: position and quaternion x, y, z, w in
     the link's frame; file: a mesh's resolved path or None; hull: `{triangles, vertices,
     cached}` for a collision mesh, else None)."""
+def demo_columns(path: str | PathLike[str], names: list[str], postures: NDArray[np.float64]) -> list[int]:
+    """The columns of demonstrations named `names` as the URDF's postures: for each actuated
+    joint in URDF order, the index of its column (any order; a mimic joint's column is checked
+    against its leader, within 1e-3, and dropped). InvalidInputError naming the missing,
+    unknown or repeated joint, or the first row where a mimic column disagrees."""
 def end_reasons() -> list[str]:
     """The end reasons by code: their names in results files (0 timeout … 5 variance_gate)."""

@@ -219,6 +219,8 @@ def build_parser() -> argparse.ArgumentParser:
     urdf = sub.add_parser("urdf-info", help="what a URDF holds as the physics loads it: joints, links, collision shapes, mass")
     urdf.add_argument("urdf", type=Path, help="the robot's URDF file")
     urdf.add_argument("--json", action="store_true", help="print it as JSON instead of a table")
+    urdf.add_argument("--balance-inertia", action="store_true",
+                      help="repair inertias the physics refuses (triangle inequality, all zero), naming each link")
     return parser
 
 
@@ -402,8 +404,11 @@ def _replay(args: argparse.Namespace) -> int:
 def _urdf_info(args: argparse.Namespace) -> int:
     from latentrl.robot_info import format_info, urdf_info
 
-    info = urdf_info(args.urdf)
+    info = urdf_info(args.urdf, balance_inertia=args.balance_inertia)
     print(json.dumps(info, indent=2) if args.json else format_info(info))
+    if args.json:  # the table lists them; JSON on stdout stays one document
+        for warning in info["warnings"]:
+            print(f"latentrl: warning: {warning}", file=sys.stderr)
     return 0
 
 

@@ -11,10 +11,12 @@ from typing import Any
 from latentrl import _native
 
 
-def urdf_info(path: str | PathLike[str]) -> dict[str, Any]:
+def urdf_info(path: str | PathLike[str], *, balance_inertia: bool = False) -> dict[str, Any]:
     """Reads and checks the URDF at `path` (meshes hulled, as a task would load it) and returns
-    `{name, joints, links, collision, visual, total_mass}` (see `_native.urdf_info`)."""
-    return _native.urdf_info(path)
+    `{name, joints, links, collision, visual, total_mass, warnings}` (see `_native.urdf_info`).
+    With `balance_inertia`, inertias the physics cannot take are repaired instead of refused;
+    `warnings` lists every repair made (docs/robots.md)."""
+    return _native.urdf_info(path, balance_inertia=balance_inertia)
 
 
 def _limits(joint: dict[str, Any]) -> str:
@@ -51,4 +53,6 @@ def format_info(info: dict[str, Any]) -> str:
     if bodiless:
         lines.append(f"  links without collision shapes: {', '.join(bodiless)}")
     lines += ["", f"visual shapes: {len(info['visual'])} (drawn, not simulated)"]
+    if info["warnings"]:
+        lines += ["", "repaired while loading:"] + [f"  {w}" for w in info["warnings"]]
     return "\n".join(lines)

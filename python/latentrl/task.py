@@ -162,6 +162,19 @@ class Task:
             raise ValueError(f"{where}: the columns must be the actuated joints of {self.origin} in URDF order "
                              f"{expected}; got {list(joint_names)} ({detail})")
 
+    def demo_postures(self, joint_names: tuple[str, ...] | list[str], postures: NDArray[np.float64],
+                      where: str) -> NDArray[np.float64]:
+        """`postures` (columns named `joint_names`) as this robot's postures: the actuated joints'
+        columns in URDF order. Columns may come in any order; a mimic joint's column is checked
+        against its leader and dropped (the rule: `UrdfModel::demo_columns`). ValueError naming
+        `where` and the joint (or row) that does not fit."""
+        rows = np.ascontiguousarray(postures, dtype=np.float64)
+        try:
+            columns = _native.demo_columns(self.urdf_path, list(joint_names), rows)
+        except ValueError as err:  # InvalidInputError stays one
+            raise type(err)(f"{where}: {err}") from err
+        return rows[:, columns]
+
     @property
     def urdf_path(self) -> Path:
         """The robot's URDF file (the task's `urdf` key, relative to `base_dir`)."""

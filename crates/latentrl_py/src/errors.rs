@@ -101,7 +101,8 @@ pub fn sim_to_py(err: SimError) -> PyErr {
         | SimError::InvalidJointParameter { .. }
         | SimError::Param(_)
         | SimError::Task { .. }
-        | SimError::UnknownObstacle { .. } => InvalidInputError::new_err(msg),
+        | SimError::UnknownObstacle { .. }
+        | SimError::DemoColumns { .. } => InvalidInputError::new_err(msg),
     }
 }
 

@@ -42,6 +42,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(task::task_schema, m)?)?;
     m.add_function(wrap_pyfunction!(task::end_reasons, m)?)?;
     m.add_function(wrap_pyfunction!(urdf::urdf_info, m)?)?;
+    m.add_function(wrap_pyfunction!(urdf::demo_columns, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

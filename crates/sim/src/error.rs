@@ -44,7 +44,8 @@ pub enum SimError {
     /// A URDF joint has a type the physics plant does not support.
     #[error(
         "unsupported joint type {kind:?} for joint {joint:?} in {origin} \
-         (supported: revolute, continuous, prismatic, fixed)"
+         (supported: revolute, continuous, prismatic, fixed, and spherical as three continuous joints; \
+         a free-floating robot: root = \"floating\")"
     )]
     UnsupportedJointType {
         /// The joint's name.
@@ -113,6 +114,12 @@ pub enum SimError {
         id: usize,
         /// Number of obstacles in the world.
         count: usize,
+    },
+    /// Demonstration columns that do not fit the robot's joints.
+    #[error("demo columns: {reason}")]
+    DemoColumns {
+        /// What does not fit, naming the joint (and the row).
+        reason: String,
     },
 }
 

@@ -32,9 +32,11 @@ use crate::error::{Result, SimError};
 pub mod cache;
 mod check;
 mod insert;
+mod lint;
 pub mod mesh;
+mod repair;
 pub use check::{MAX_URDF_DEPTH, MAX_URDF_LINKS};
-use check::{check_joint_types, check_robot, check_size};
+use check::{check_joint_types, check_robot, check_size, inertia_problem, inertia_problems};
 pub(crate) use insert::JointSlot;
 use mesh::MeshHull;
 
@@ -55,6 +57,20 @@ impl Default for RootMode {
         Self::Fixed
     }
 }
+
+/// How a URDF is loaded: the repairs a user asks for (docs/robots.md).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Repair every `<inertia>` the physics refuses (triangle inequality broken, not positive
+    /// definite, all zero) instead of refusing it, each reported in [`UrdfModel::warnings`]:
+    /// principal moments set to their mean (MuJoCo's `balanceinertia`), or a solid box
+    /// filling the link's collision shapes when that mean is too small.
+    pub balance_inertia: bool,
+}
+
+/// How far (rad or m) a mimic joint's demo column may lie from its leader's coupling
+/// ([`UrdfModel::demo_columns`]).
+pub const MIMIC_TOLERANCE: f64 = 1e-3;
 
 /// Kind of an actuated (one-DoF) joint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -141,6 +157,8 @@ pub struct UrdfModel {
     mimics: Vec<MimicInfo>,
     /// `(link, collision element)` → its hull, for every mesh collision shape.
     pub(crate) hulls: Vec<((usize, usize), MeshHull)>,
+    /// What was repaired while loading, one sentence each.
+    warnings: Vec<String>,
 }
 
 impl UrdfModel {
@@ -154,6 +172,11 @@ impl UrdfModel {
 
     /// [`UrdfModel::from_file`] with the mesh hull cache in `cache` (`None`: no cache).
     pub fn from_file_with_cache(path: impl AsRef<Path>, cache: Option<&Path>) -> Result<Self> {
+        Self::from_file_with_options(path, cache, LoadOptions::default())
+    }
+
+    /// [`UrdfModel::from_file_with_cache`] with the repairs of `options`.
+    pub fn from_file_with_options(path: impl AsRef<Path>, cache: Option<&Path>, options: LoadOptions) -> Result<Self> {
         let path = path.as_ref();
         let origin = path.display().to_string();
         let xml = std::fs::read_to_string(path).map_err(|e| SimError::MissingFile {
@@ -165,7 +188,7 @@ impl UrdfModel {
             .filter(|p| !p.as_os_str().is_empty())
             .unwrap_or(Path::new("."));
         let folder = std::fs::canonicalize(parent).unwrap_or_else(|_| parent.to_path_buf());
-        Self::parse_with(&xml, &origin, &folder, cache)
+        Self::parse_with_options(&xml, &origin, &folder, cache, options)
     }
 
     /// Parses and checks a URDF document held in a string (mesh paths relative to the
@@ -197,12 +220,34 @@ impl UrdfModel {
     /// than [`MAX_URDF_DEPTH`] or with more than [`MAX_URDF_LINKS`] links is refused as
     /// malformed before it is parsed.
     pub fn parse_with(xml: &str, origin: &str, folder: &Path, cache: Option<&Path>) -> Result<Self> {
+        Self::parse_with_options(xml, origin, folder, cache, LoadOptions::default())
+    }
+
+    /// [`UrdfModel::parse_with`] with the repairs of `options`. Before the XML parser, a scan of
+    /// the text refuses SDF, MJCF and xacro files by name and a malformed number naming its
+    /// line and element, and repairs xacro's `$(optenv …)` and stray elements in `<geometry>`;
+    /// after it, revolute joints without a range load as continuous and spherical joints as
+    /// three continuous ones. Every repair is in [`UrdfModel::warnings`]. Without
+    /// `balance_inertia`, the links whose inertia the physics cannot take are refused all in
+    /// one error.
+    pub fn parse_with_options(
+        xml: &str,
+        origin: &str,
+        folder: &Path,
+        cache: Option<&Path>,
+        options: LoadOptions,
+    ) -> Result<Self> {
         check_size(xml, origin)?;
-        check_joint_types(xml, origin)?;
-        let robot = urdf_rs::read_from_string(xml).map_err(|e| SimError::MalformedUrdf {
+        let scan = lint::scan(xml, origin)?;
+        check_joint_types(&scan.text, origin)?;
+        let bad = |reason: String| SimError::MalformedUrdf {
             origin: origin.to_string(),
-            reason: e.to_string(),
-        })?;
+            reason,
+        };
+        let mut robot = urdf_rs::read_from_string(&scan.text).map_err(|e| bad(e.to_string()))?;
+        let mut warnings = scan.warnings;
+        repair::unlimited_revolutes(&mut robot, &scan.no_range, &mut warnings);
+        repair::split_spherical(&mut robot, &mut warnings).map_err(bad)?;
         let (joints, mimics) = check_robot(&robot, origin)?;
         let mut model = Self {
             robot,
@@ -211,9 +256,77 @@ impl UrdfModel {
             joints,
             mimics,
             hulls: Vec::new(),
+            warnings,
         };
         model.hulls = model.load_hulls(cache)?;
+        model.balance_inertia(options.balance_inertia)?;
         Ok(model)
+    }
+
+    /// Refuses (all in one error), or with `repair` balances, every link whose inertia the
+    /// physics cannot take ([`repair::balanced`]).
+    fn balance_inertia(&mut self, repair: bool) -> Result<()> {
+        let problems = inertia_problems(&self.robot);
+        if problems.is_empty() {
+            return Ok(());
+        }
+        let bad = |reason: String| SimError::MalformedUrdf {
+            origin: self.origin.clone(),
+            reason,
+        };
+        if !repair {
+            let list: Vec<String> = problems
+                .iter()
+                .map(|(l, p)| {
+                    let link = &self.robot.links[*l];
+                    format!(
+                        "link {:?} has mass {} but its <inertia> {p}",
+                        link.name, link.inertial.mass.value
+                    )
+                })
+                .collect();
+            return Err(bad(format!(
+                "{} link(s) with an inertia the physics cannot take: {}; `latentrl urdf-info \
+                 --balance-inertia` (LoadOptions::balance_inertia) repairs them, reporting each",
+                list.len(),
+                list.join("; ")
+            )));
+        }
+        for (l, _) in problems {
+            let link = &self.robot.links[l];
+            let mut points = Vec::new();
+            for (c, collision) in link.collision.iter().enumerate() {
+                let pose = crate::pose::origin_pose(&collision.origin);
+                let local = repair::primitive_corners(&collision.geometry).unwrap_or_else(|| {
+                    let hull = self.hulls.iter().find(|(at, _)| *at == (l, c));
+                    hull.map_or(Vec::new(), |(_, h)| {
+                        h.points
+                            .iter()
+                            .map(|p| nalgebra::Point3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
+                            .collect()
+                    })
+                });
+                points.extend(local.iter().map(|p| pose * p));
+            }
+            let mass = link.inertial.mass.value;
+            let Some((inertia, what)) = repair::balanced(link, &points, |t| inertia_problem(mass, t).is_none()) else {
+                return Err(bad(format!(
+                    "link {:?} has mass {mass} but an <inertia> {}, and no collision shape to size a \
+                     repair from: give it an <inertia>",
+                    link.name,
+                    inertia_problem(mass, &link.inertial.inertia).unwrap_or_default()
+                )));
+            };
+            self.warnings.push(format!("link {:?}: <inertia> {what}", link.name));
+            self.robot.links[l].inertial.inertia = inertia;
+        }
+        Ok(())
+    }
+
+    /// What was repaired while loading (xacro leftovers, ranges, spherical joints, inertias),
+    /// one sentence each naming the line, joint or link; empty for a clean URDF.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// The convex hull of every mesh collision shape ([`mesh::load_hull`]).
@@ -257,6 +370,59 @@ impl UrdfModel {
     /// Whether `name` is a joint with a servo (actuated or mimic): what `servo.joints` may name.
     pub fn is_servoed(&self, name: &str) -> bool {
         self.joint_index(name).is_ok() || self.mimics.iter().any(|m| m.joint.name == name)
+    }
+
+    /// The columns of demonstrations named `names` (rows of `names.len()` values each) as
+    /// postures: for each actuated joint in URDF order, the index of its column. Columns may
+    /// come in any order; a mimic joint's column is checked against its leader's
+    /// ([`MimicInfo::follow`], within [`MIMIC_TOLERANCE`]) and dropped. Fails naming the
+    /// missing, unknown or repeated joint, or the first row where a mimic column disagrees.
+    pub fn demo_columns(&self, names: &[&str], rows: &[Vec<f64>]) -> Result<Vec<usize>> {
+        let bad = |reason: String| SimError::DemoColumns { reason };
+        for (k, name) in names.iter().enumerate() {
+            if names[..k].contains(name) {
+                return Err(bad(format!("joint {name:?} has two columns")));
+            }
+        }
+        let unknown: Vec<&str> = names.iter().copied().filter(|n| !self.is_servoed(n)).collect();
+        let missing: Vec<&str> = self.joint_names().into_iter().filter(|j| !names.contains(j)).collect();
+        if !unknown.is_empty() || !missing.is_empty() {
+            let listed = |names: &[&str]| {
+                format!(
+                    "[{}]",
+                    names.iter().map(|n| format!("'{n}'")).collect::<Vec<_>>().join(", ")
+                )
+            };
+            let mimics: Vec<&str> = self.mimics.iter().map(|m| m.joint.name.as_str()).collect();
+            return Err(bad(format!(
+                "missing {}, not joints of the robot {} (the columns are its actuated joints {}, in any order, \
+                 and optionally its mimic joints {})",
+                listed(&missing),
+                listed(&unknown),
+                listed(&self.joint_names()),
+                listed(&mimics)
+            )));
+        }
+        let column = |name: &str| names.iter().position(|n| *n == name).unwrap_or(0);
+        let order: Vec<usize> = self.joints.iter().map(|j| column(&j.name)).collect();
+        for m in &self.mimics {
+            let Some(c) = names.iter().position(|n| *n == m.joint.name) else {
+                continue;
+            };
+            let leader = order[m.leader];
+            for (r, row) in rows.iter().enumerate() {
+                let (value, expected) = (row[c], m.follow(row[leader]));
+                let close = (value - expected).abs() <= MIMIC_TOLERANCE; // false for NaN
+                if !close {
+                    return Err(bad(format!(
+                        "row {r}: mimic joint {:?} is {value}, but {} * {:?} ({}) + {} gives {expected} \
+                         (clamped to its limits; tolerance {MIMIC_TOLERANCE})",
+                        m.joint.name, m.multiplier, self.joints[m.leader].name, row[leader], m.offset
+                    )));
+                }
+            }
+        }
+        Ok(order)
     }
 
     /// Names of the joints with a servo: the actuated ones, then the mimic ones.

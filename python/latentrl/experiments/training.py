@@ -42,15 +42,15 @@ class TrainRun(TrainPreset):
 def _load(task_file: str, overrides: tuple[tuple[str, Any], ...], demos: str, model: str,
           seed: int, max_iter: int, encoder: str) -> tuple[Task, np.ndarray, GPLVM]:
     task = Task.load(task_file).replace(dict(overrides))
-    postures = load_demos(demos, min_postures=3)
-    task.check_joints(postures.joint_names, demos)
+    loaded = load_demos(demos, min_postures=3)
+    postures = task.demo_postures(loaded.joint_names, loaded.postures, demos)
     gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder)
     if model:
         if gplvm.n_features_in_ != len(task.joint_names):
             raise ValueError(f"{model}: fitted to {gplvm.n_features_in_} joints, the task's robot has {len(task.joint_names)}")
     else:
-        gplvm.fit(postures.postures)
-    return task, postures.postures, gplvm
+        gplvm.fit(postures)
+    return task, postures, gplvm
 
 
 def fitted(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GPLVM]:

@@ -98,7 +98,8 @@ fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
 
 /// Rejects joint types before `urdf-rs` turns an unknown one into an opaque XML error.
 pub(super) fn check_joint_types(xml: &str, origin: &str) -> Result<()> {
-    const SUPPORTED: [&str; 4] = ["revolute", "continuous", "prismatic", "fixed"];
+    // `spherical` joints become three continuous ones (`repair::split_spherical`).
+    const SUPPORTED: [&str; 5] = ["revolute", "continuous", "prismatic", "fixed", "spherical"];
     let clean = strip_comments(xml);
     let mut rest = clean.as_str();
     while let Some(pos) = rest.find("<joint") {
@@ -119,6 +120,21 @@ pub(super) fn check_joint_types(xml: &str, origin: &str) -> Result<()> {
         rest = after;
     }
     Ok(())
+}
+
+/// `(link index, problem)` of every link with mass whose `<inertia>` the physics cannot take
+/// ([`inertia_problem`]), all of them (so that a user sees every one at once).
+pub(super) fn inertia_problems(robot: &urdf_rs::Robot) -> Vec<(usize, String)> {
+    let mut out = Vec::new();
+    for (l, link) in robot.links.iter().enumerate() {
+        let i = &link.inertial;
+        if i.mass.value > 0.0
+            && let Some(problem) = inertia_problem(i.mass.value, &i.inertia)
+        {
+            out.push((l, problem));
+        }
+    }
+    out
 }
 
 /// Structural checks the loader does not make (it would panic or silently drop things).
@@ -154,14 +170,6 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<(Vec<J
         let owner = format!("link {:?}", link.name);
         check_magnitudes(&owner, link_numbers(link)).map_err(bad)?;
         check_lengths(&owner, link_lengths(link)).map_err(bad)?;
-        if i.mass.value > 0.0
-            && let Some(problem) = inertia_problem(i.mass.value, &i.inertia)
-        {
-            return Err(bad(format!(
-                "link {:?} has mass {} but its <inertia> {problem}",
-                link.name, i.mass.value
-            )));
-        }
         check_collisions(link).map_err(bad)?;
     }
     let mut joint_names = HashSet::new();
@@ -216,8 +224,13 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<(Vec<J
             check_lengths(&owner, vec![("limit lower", lower), ("limit upper", upper)]).map_err(bad)?;
         }
         if kind != JointKind::Continuous && !(lower.is_finite() && upper.is_finite() && lower < upper) {
+            let advice = if lower == upper {
+                ": it cannot move; make it type=\"fixed\", or give it a range"
+            } else {
+                ""
+            };
             return Err(bad(format!(
-                "joint {:?} needs <limit lower upper> with lower < upper, got [{lower}, {upper}]",
+                "joint {:?} needs <limit lower upper> with lower < upper, got [{lower}, {upper}]{advice}",
                 joint.name
             )));
         }
@@ -434,7 +447,7 @@ const TRIANGLE_SLACK: f64 = 1e-2;
 /// (each principal moment at most the sum of the other two, within `TRIANGLE_SLACK`).
 /// A zero, singular or unphysical tensor makes the multibody mass matrix singular or so
 /// ill-conditioned in f32 that the first steps give NaN, and the next one panics in rapier.
-fn inertia_problem(mass: f64, t: &urdf_rs::Inertia) -> Option<String> {
+pub(super) fn inertia_problem(mass: f64, t: &urdf_rs::Inertia) -> Option<String> {
     let f = |v: f64| f64::from(v as f32);
     let (xx, yy, zz, xy, xz, yz) = (f(t.ixx), f(t.iyy), f(t.izz), f(t.ixy), f(t.ixz), f(t.iyz));
     let diagonal = [xx, yy, zz].iter().all(|v| *v > 0.0 && (*v as f32).is_normal());
@@ -449,20 +462,20 @@ fn inertia_problem(mass: f64, t: &urdf_rs::Inertia) -> Option<String> {
     let floor = mass * MIN_GYRATION_RADIUS * MIN_GYRATION_RADIUS;
     if moments[0] < floor {
         return Some(format!(
-            "has a principal moment {:e} below mass x (1 um)^2 = {floor:e} kg m^2",
+            "has a principal moment {:.4e} below mass x (1 um)^2 = {floor:.4e} kg m^2",
             moments[0]
         ));
     }
     let ceiling = mass * LENGTH_MAX * LENGTH_MAX;
     if moments[2] > ceiling {
         return Some(format!(
-            "has a principal moment {:e} above mass x (1 km)^2 = {ceiling:e} kg m^2",
+            "has a principal moment {:.4e} above mass x (1 km)^2 = {ceiling:.4e} kg m^2",
             moments[2]
         ));
     }
     if moments[2] > (moments[0] + moments[1]) * (1.0 + TRIANGLE_SLACK) {
         return Some(format!(
-            "breaks the triangle inequality: principal moments {:e}, {:e}, {:e} \
+            "breaks the triangle inequality: principal moments {:.4e}, {:.4e}, {:.4e} \
              (the largest may not exceed the sum of the other two)",
             moments[0], moments[1], moments[2]
         ));
