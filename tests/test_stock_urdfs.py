@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from latentrl import InvalidInputError, Task
+from latentrl._native import Sim
 from latentrl.robot_info import urdf_info
 
 ARM7 = Path(__file__).parent / "robots" / "arm7_description" / "urdf" / "arm7.urdf"
@@ -57,6 +58,17 @@ def test_balance_inertia_names_every_link_at_once_then_repairs_each(tmp_path):
     as_json = urdf_info_cli(str(path), "--balance-inertia", "--json")
     assert json.loads(as_json.stdout)["warnings"] == info["warnings"]
     assert as_json.stderr.count("latentrl: warning: link") == 3
+
+
+def test_sim_takes_balance_inertia_and_steps_the_repaired_robot(tmp_path):
+    zero = LINK.format(name="a", mass=12.0, ixx=0, iyy=0, izz=0)
+    path = robot(tmp_path, zero + hinge("j", "a"))
+    with pytest.raises(InvalidInputError, match='link "a" has mass 12 but its <inertia> is not positive definite'):
+        Sim(path)
+    sim = Sim(path, balance_inertia=True)
+    sim.set_targets(np.array([0.5]))
+    sim.step(480)
+    assert abs(sim.joint_positions()[0] - 0.5) < 0.05
 
 
 @pytest.mark.parametrize("text, message", [

@@ -124,10 +124,12 @@ class Sim:
         floor: float | None = None,
         physics: Mapping[str, object] | None = None,
         servo: Mapping[str, object] | None = None,
+        balance_inertia: bool = False,
     ) -> Sim:
         """Builds the world from `urdf`: a path, or the URDF XML itself (a str starting with `<`).
         `root` "fixed" or "floating"; `floor` the height of a floor half-space (normal +z) or
-        None; `physics` and `servo` dicts of the task file's `[physics]` and `[servo]` keys."""
+        None; `physics` and `servo` dicts of the task file's `[physics]` and `[servo]` keys;
+        `balance_inertia` repairs inertias the physics cannot take (`urdf-info --balance-inertia`)."""
     @property
     def joint_names(self) -> list[str]:
         """Names of the actuated joints, in the order of postures and targets."""

@@ -1,9 +1,10 @@
 //! Binding of `sim::world`: a URDF robot in a rapier3d world with PD servos ([`World`]),
 //! driven from Python one RL step (or `n` physics steps) per call.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use ::sim::fall::reset_on_ground;
+use ::sim::urdf::LoadOptions;
 use ::sim::{
     FallCriteria, Obstacle, ObstacleShape, PhysicsConfig, RootMode, ServoConfig, UrdfModel, World, WorldConfig,
 };
@@ -29,9 +30,10 @@ pub struct PySim {
 impl PySim {
     /// Builds the world from `urdf`: a path, or the URDF XML itself (a str starting with `<`).
     /// `root` "fixed" or "floating"; `floor` the height of a floor half-space (normal +z) or
-    /// None; `physics` and `servo` dicts of the task file's `[physics]` and `[servo]` keys.
+    /// None; `physics` and `servo` dicts of the task file's `[physics]` and `[servo]` keys;
+    /// `balance_inertia` repairs inertias the physics cannot take (`urdf-info --balance-inertia`).
     #[new]
-    #[pyo3(signature = (urdf, *, root = "fixed", floor = None, physics = None, servo = None))]
+    #[pyo3(signature = (urdf, *, root = "fixed", floor = None, physics = None, servo = None, balance_inertia = false))]
     fn new(
         py: Python<'_>,
         urdf: &Bound<'_, PyAny>,
@@ -39,6 +41,7 @@ impl PySim {
         floor: Option<f64>,
         physics: Option<&Bound<'_, PyAny>>,
         servo: Option<&Bound<'_, PyAny>>,
+        balance_inertia: bool,
     ) -> PyResult<Self> {
         guard(|| {
             let root = match root {
@@ -58,13 +61,17 @@ impl PySim {
                 physics,
                 servo,
             };
+            let options = LoadOptions { balance_inertia };
+            let cache = ::sim::urdf::cache::default_folder();
             let model = match urdf.extract::<String>() {
-                Ok(text) if text.trim_start().starts_with('<') => UrdfModel::parse(&text),
+                Ok(text) if text.trim_start().starts_with('<') => {
+                    UrdfModel::parse_with_options(&text, "<string>", Path::new("."), cache.as_deref(), options)
+                }
                 _ => {
                     let path: PathBuf = urdf
                         .extract()
                         .map_err(|_| InvalidInputError::new_err("urdf: expected a path or the URDF XML as a str"))?;
-                    py.detach(|| UrdfModel::from_file(path))
+                    py.detach(|| UrdfModel::from_file_with_options(path, cache.as_deref(), options))
                 }
             }
             .map_err(sim_to_py)?;
