@@ -108,13 +108,16 @@ def test_records_tests_and_task_echo(fitted):
     assert [list(o["min"]) for o in task["obstacles"]] == [[-1.0, 0.30, -1.0], [-0.06, 0.30, -1.0]]
 
 
-def test_a_rollout_is_greedy_and_frozen(fitted):
+@pytest.mark.parametrize("policy", ["greedy", "softmax", "random"])
+def test_a_rollout_is_frozen_and_repeats(fitted, policy):
     trained = run_task_trials(arms()._native, **arms_kwargs(fitted, return_weights=True))
     w = trained["weights"][0]
-    kwargs = arms_kwargs(fitted, n_trials=1, weights=w, rollout=True, return_weights=True)
+    kwargs = arms_kwargs(fitted, n_trials=1, weights=w, rollout=policy, return_weights=True)
     once, again = run_task_trials(arms()._native, **kwargs), run_task_trials(arms()._native, **kwargs)
     np.testing.assert_array_equal(once["weights"][0], w, err_msg="a rollout learns nothing")
     np.testing.assert_array_equal(once["returns"], again["returns"])
+    with pytest.raises(ValueError, match='rollout must be one of greedy | softmax | random, got "best"'):
+        run_task_trials(arms()._native, **{**kwargs, "rollout": "best"})
 
 
 @pytest.fixture(scope="module")

@@ -35,6 +35,7 @@ __all__ = [
     "learner_values",
     "run_bimanual_trials",
     "run_task_trials",
+    "latent_survey",
     "task_schema",
     "urdf_info",
     "demo_columns",
@@ -392,7 +393,8 @@ def run_task_trials(
     base_seed: int,
     demos: NDArray[np.float64] | None = None,
     weights: NDArray[np.float64] | None = None,
-    rollout: bool = False,
+    rollout: str | None = None,
+    test_starts: bool = False,
     first_trial: int | None = None,
     record_episodes: Sequence[int] | None = None,
     test_episodes: int | None = None,
@@ -401,6 +403,19 @@ def run_task_trials(
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
     """One trial runner for every task: trials of the task's latent learner in parallel in Rust."""
+
+def latent_survey(
+    task: Task,
+    *,
+    decoder: GpMap,
+    latent_low: ArrayLike,
+    latent_high: ArrayLike,
+    demos: NDArray[np.float64] | None = None,
+    max_points: int = 20000,
+    progress: Callable[[int, int], object] | None = None,
+) -> dict[str, Any]:
+    """The task's latent space at rest on a grid at its learner step: per point the rule broken,
+    reward, distance, reached, effectors, and the fewest learner moves to the target region."""
 
 def learner_values(
     learner: Mapping[str, object],
@@ -433,4 +448,4 @@ def demo_columns(path: str | PathLike[str], names: list[str], postures: NDArray[
     against its leader, within 1e-3, and dropped). InvalidInputError naming the missing,
     unknown or repeated joint, or the first row where a mimic column disagrees."""
 def end_reasons() -> list[str]:
-    """The end reasons by code: their names in results files (0 timeout … 5 variance_gate)."""
+    """The end reasons by code: their names in results files (0 timeout … 6 success)."""

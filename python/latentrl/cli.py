@@ -3,7 +3,8 @@ a latent policy on a task of your own and roll it out, fit a model to demonstrat
 the figures of a results directory, show versions.
 
 Exit codes: 0 done, 1 bad values, a bad file or a failed run (the message says what), 2 bad
-arguments (argparse), 130 interrupted (finished trials are kept; `--resume` continues).
+arguments (argparse), 3 `check` found that the task will not learn, 130 interrupted (finished
+trials are kept; `--resume` continues).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from latentrl.experiments.presets import field_docs, with_overrides
 from latentrl.experiments.registry import experiments, task_schema
 from latentrl.experiments.results import environment, read_json, write_json
 from latentrl.task import by_path, changed_since
+from latentrl.train import POLICIES
 
 TASK_PREFIX = "task:"
 """Prefix of the argparse destinations of task keys (`task:learner.alpha`)."""
@@ -173,14 +175,28 @@ def build_parser() -> argparse.ArgumentParser:
 
     _add_preset_flags(train, TrainRun, exclude=("task_file", "demos", "model"))
     _add_task_flags(train, _native.task_schema())  # defaults: the task file's, else these
-    rollout = sub.add_parser("rollout", help="run a trained policy (greedy or soft-max, no learning) and write OUT/rollout.json")
+    check = sub.add_parser("check", help="before training: will the task learn from these demos? (exit 3 if not)")
+    check.add_argument("task", type=Path, help="the task file (TOML; docs/tasks.md)")
+    check.add_argument("--demos", type=Path, required=True, help="demonstrated postures: .csv (header of joint names), .npz or .json")
+    check.add_argument("--model", type=Path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2)")
+    check.add_argument("--quick", action="store_true", help="cost the short run (TrainPreset.quick) instead of the default")
+    check.add_argument("--json", action="store_true", help="print the findings as JSON instead of a table")
+    check.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
+    _add_preset_flags(check, TrainRun, exclude=("task_file", "demos", "model"))
+    _add_task_flags(check, _native.task_schema())
+    rollout = sub.add_parser("rollout", help="run a trained policy frozen (greedy, soft-max, and the random control from "
+                                             "the same starts) and write OUT/rollout.json")
     rollout.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz), or a policy.npz")
     rollout.add_argument("--out", type=Path, required=True, help="where to write rollout.json and rollout.npz")
-    rollout.add_argument("--episodes", type=int, default=20, help="episodes per trial (default: 20)")
+    rollout.add_argument("--episodes", type=int, default=20, help="episodes per trial and policy (default: 20)")
     rollout.add_argument("--trial", type=int, help="only this trial's policy (default: every trial)")
-    rollout.add_argument("--seed", type=int, default=0, help="base seed of the starts (default: 0)")
-    rollout.add_argument("--softmax", action="store_true",
-                         help="draw each action from the learner's soft-max, as a run's frozen tests do (default: greedy)")
+    rollout.add_argument("--seed", type=int, default=0, help="base seed of the starts and draws (default: 0)")
+    rollout.add_argument("--starts", choices=("test", "train"), default="test",
+                         help="test: where the task's frozen tests start (episode.test_start); train: as its training "
+                              "episodes (default: test)")
+    rollout.add_argument("--policy", type=_policies, default=list(POLICIES), metavar="P[,P…]",
+                         help="which of greedy, softmax (the learner's soft-max, as the frozen tests draw) and random "
+                              "(the control: uniform moves, cannot learn) to run (default: all three)")
     rollout.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     fit = sub.add_parser("fit", help="fit a PCA or GPLVM to a demonstration file and save it (NPZ)")
     fit.add_argument("demos", type=Path, help="demonstrated postures: .csv (header of joint names), .npz or .json")
@@ -301,31 +317,75 @@ def _train(args: argparse.Namespace) -> int:
     return code
 
 
-def _rollout(args: argparse.Namespace) -> int:
-    from latentrl.train import LatentPolicy
-
-    path = args.results / "policy.npz" if args.results.is_dir() else args.results
-    policy = LatentPolicy.load(path)
-    if args.episodes < 1:
-        raise ValueError(f"--episodes must be at least 1, got {args.episodes}")
+def _check(args: argparse.Namespace) -> int:
+    from latentrl.check import check_task
+    from latentrl.experiments.presets import latent_box
+    from latentrl.experiments.results import worker_threads
+    from latentrl.experiments.training import TrainRun, fitted
     from latentrl.progress import progress_bar
 
-    with progress_bar(unit="ep", desc="rollout", disable=not args.progress) as bar:
+    base = TrainRun.quick() if args.quick else TrainRun()
+    files = {"task_file": str(args.task), "demos": str(args.demos), "model": str(args.model or "")}
+    run = dataclasses.replace(with_overrides(base, _overrides(args, TrainRun)), **files)
+    run.validate()  # the same checks of files, keys and columns as train
+    task, demos, model = fitted(run)
+    low, high = latent_box(model.Z_, run.latent_margin)
+    with progress_bar(unit="pt", desc="survey", disable=not args.progress) as bar:
         def report(done: int, total: int) -> None:
             bar.total = total
             bar.update(done - bar.n)
 
-        result = policy.rollout(args.episodes, trial=args.trial, seed=args.seed, softmax=args.softmax, progress=report)
-    args.out.mkdir(parents=True, exist_ok=True)
-    from latentrl.experiments.results import write_npz
+        found = check_task(task, demos, model, low, high, budget=(run.trials, run.episodes),
+                           threads=worker_threads(), progress=report)
+    print(json.dumps(found.to_dict(), indent=2) if args.json else found)
+    return 3 if found.verdict == "will not learn" else 0
 
-    write_npz(args.out / "rollout.npz", {k: result[k] for k in ("returns", "ends", "reached", "paths")})
-    summary = {"policy": str(path), "task": policy.task.name, "trials": result["trials"], "episodes": args.episodes,
-               "seed": args.seed, "policy_kind": "softmax" if args.softmax else "greedy", **result["summary"],
-               "environment": environment()}
+
+def _rollout(args: argparse.Namespace) -> int:
+    from latentrl.experiments.results import write_npz
+    from latentrl.progress import progress_bar
+    from latentrl.train import LatentPolicy
+
+    path = args.results / "policy.npz" if args.results.is_dir() else args.results
+    if args.episodes < 1:
+        raise ValueError(f"--episodes must be at least 1, got {args.episodes}")
+    policy = LatentPolicy.load(path)
+    results: dict[str, dict[str, Any]] = {}
+    with progress_bar(unit="ep", desc="rollout", disable=not args.progress) as bar:
+        for kind in args.policy:
+            def report(done: int, total: int) -> None:
+                bar.total = total * len(args.policy)
+                bar.update(len(results) * total + done - bar.n)
+
+            results[kind] = policy.rollout(args.episodes, trial=args.trial, seed=args.seed, policy=kind,
+                                           starts=args.starts, progress=report)
+    args.out.mkdir(parents=True, exist_ok=True)
+    write_npz(args.out / "rollout.npz", {f"{kind}_{k}": r[k] for kind, r in results.items()
+                                         for k in ("returns", "ends", "reached", "paths")})
+    summary = {"policy": str(path.resolve()), "task": policy.task.name, "trials": next(iter(results.values()))["trials"],
+               "episodes": args.episodes, "seed": args.seed, "starts": args.starts,
+               **{kind: r["summary"] for kind, r in results.items()}, "environment": environment()}
     write_json(args.out / "rollout.json", summary)
-    print(json.dumps({k: summary[k] for k in ("reached", "ends", "mean_return")}))
+    for kind, r in results.items():
+        print(f"{kind:8s} {format_rollout(r['summary'])}")
     return 0
+
+
+def format_rollout(summary: dict[str, Any]) -> str:
+    """One line of a rollout summary: success, reached at any step, mean return, endings."""
+    success = "-" if summary["success"] is None else f"{summary['success']:.0%}"
+    ends = ", ".join(f"{name} {n}" for name, n in summary["ends"].items() if n)
+    return (f"success {success:>4}  reached (any step) {summary['reached_any_step']:4.0%}  "
+            f"mean return {summary['mean_return']:8.2f}  ends: {ends}")
+
+
+def _policies(text: str) -> list[str]:
+    """`--policy`: a comma-separated subset of `POLICIES`, in their order."""
+    chosen = [p.strip() for p in text.split(",") if p.strip()]
+    unknown = [p for p in chosen if p not in POLICIES]
+    if unknown or not chosen:
+        raise argparse.ArgumentTypeError(f"expected some of {', '.join(POLICIES)}, got {text!r}")
+    return [p for p in POLICIES if p in chosen]
 
 
 def _fit(args: argparse.Namespace) -> int:
@@ -431,7 +491,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "info":
         print(json.dumps(environment(), indent=2))
         return 0
-    command = {"run": _run, "train": _train, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep,
+    command = {"run": _run, "train": _train, "check": _check, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep,
                "urdf-info": _urdf_info, "replay": _replay}
     try:
         out = getattr(args, "out", None)
@@ -448,6 +508,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise
         print("latentrl: error: figures need matplotlib: pip install 'latentrl[plot]'", file=sys.stderr)
         return 1
+    except KeyboardInterrupt:  # commands that keep work say more themselves (`_interruptible`)
+        print("latentrl: interrupted; nothing was written", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

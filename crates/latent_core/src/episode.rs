@@ -300,6 +300,20 @@ impl Learner {
         space: &StateSpace<'_>,
         rng: &mut R,
         s: &mut EpisodeScratch,
+        trajectory: Option<&mut Vec<f64>>,
+    ) -> Result<EpisodeRecord> {
+        self.run_episode_with(plant, space, rng, None::<&mut R>, s, trajectory)
+    }
+
+    /// [`Self::run_episode`] with the start drawn from `rng` and, if given, the actions from
+    /// `actions` (a rollout: so policies that draw differently meet the same starts).
+    pub fn run_episode_with<P: Plant, R: Rng + ?Sized, A: Rng + ?Sized>(
+        &mut self,
+        plant: &mut P,
+        space: &StateSpace<'_>,
+        rng: &mut R,
+        mut actions: Option<&mut A>,
+        s: &mut EpisodeScratch,
         mut trajectory: Option<&mut Vec<f64>>,
     ) -> Result<EpisodeRecord> {
         self.start(plant, space, rng, s)?;
@@ -322,7 +336,10 @@ impl Learner {
         s.mean_z.copy_from_slice(&s.z);
         let mut states = 1.0;
         while record.steps < self.rules.max_steps {
-            let r = self.step(plant, space, rng, s);
+            let r = match actions.as_deref_mut() {
+                Some(a) => self.step(plant, space, a, s),
+                None => self.step(plant, space, rng, s),
+            };
             record.steps += 1;
             record.ret += r.reward;
             if r.moved {

@@ -35,16 +35,16 @@ pub fn trial_rng(base_seed: u64, trial: usize) -> ChaCha8Rng {
     rng
 }
 
-/// The generator of rollout episode `episode` of trial `trial`: ChaCha8 seeded from the three
-/// indices. A rollout draws each episode's start, then its actions, from its own generator, so
-/// every policy rolled out with the same seed (greedy, soft-max, the random control) meets the
-/// same starts, whatever the actions before consumed.
+/// The generator of the actions of rollout episode `episode` of trial `trial`: ChaCha8 seeded
+/// from the three indices. A rollout draws its starts from the trial's generator and its actions
+/// from these, so every policy rolled out with the same seed (greedy, soft-max, the random
+/// control) meets the same starts, and a greedy rollout draws as it did before it had them.
 pub fn episode_rng(base_seed: u64, trial: usize, episode: usize) -> ChaCha8Rng {
     let mut seed = [0u8; 32];
     seed[..8].copy_from_slice(&base_seed.to_le_bytes());
     seed[8..16].copy_from_slice(&(trial as u64).to_le_bytes());
     seed[16..24].copy_from_slice(&(episode as u64).to_le_bytes());
-    seed[24..].copy_from_slice(b"rollout\0");
+    seed[24..].copy_from_slice(b"actions\0");
     ChaCha8Rng::from_seed(seed)
 }
 
@@ -69,7 +69,7 @@ pub struct TrialOptions {
     /// Test-episode indices (0-based) whose task-space trajectory is recorded.
     pub record_test_episodes: Vec<usize>,
     /// The phase of the `episodes` ([`Phase::Train`]; [`Phase::Rollout`] runs a trained
-    /// template's policy frozen, each episode from its [`episode_rng`]).
+    /// template's policy frozen, each episode's actions from its [`episode_rng`]).
     pub phase: Phase,
 }
 
@@ -250,12 +250,11 @@ fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
     learner.set_phase(options.phase);
     let scratch = learner.scratch(space, plant.posture_dim());
     let rng = trial_rng(options.base_seed, trial);
-    let rollout = matches!(options.phase, Phase::Rollout { .. });
     let mut run = TrialRun {
         plant,
         learner,
         rng,
-        episode_seed: rollout.then_some((options.base_seed, trial)),
+        episode_seed: (options.base_seed, trial),
         scratch,
         space,
         cancel,
@@ -294,8 +293,9 @@ struct TrialRun<'a, P> {
     plant: P,
     learner: Learner,
     rng: ChaCha8Rng,
-    /// A rollout's seed and trial: each episode draws from its own [`episode_rng`].
-    episode_seed: Option<(u64, usize)>,
+    /// The base seed and the trial: a rollout episode draws its actions from its own
+    /// [`episode_rng`].
+    episode_seed: (u64, usize),
     scratch: EpisodeScratch,
     space: &'a StateSpace<'a>,
     cancel: &'a AtomicBool,
@@ -322,22 +322,17 @@ impl<P: Plant> TrialRun<'_, P> {
             if self.cancel.load(Ordering::Relaxed) {
                 return Ok((episodes, trajectories, false));
             }
-            let mut own;
-            let rng = match self.episode_seed {
-                Some((seed, trial)) => {
-                    own = episode_rng(seed, trial, e);
-                    &mut own
-                }
-                None => &mut self.rng,
-            };
-            let (plant, space, scratch) = (&mut self.plant, self.space, &mut self.scratch);
-            let rec = if starts.is_some() || record.contains(&e) {
+            let (plant, rng, space, scratch) = (&mut self.plant, &mut self.rng, self.space, &mut self.scratch);
+            let rollout = matches!(self.learner.phase(), Phase::Rollout { .. });
+            let (seed, trial) = self.episode_seed;
+            let mut actions = rollout.then(|| episode_rng(seed, trial, e));
+            let path = (starts.is_some() || record.contains(&e)).then(|| {
                 buffer.clear();
-                self.learner
-                    .run_episode(plant, space, rng, scratch, Some(&mut buffer))?
-            } else {
-                self.learner.run_episode(plant, space, rng, scratch, None)?
-            };
+                &mut buffer
+            });
+            let rec = self
+                .learner
+                .run_episode_with(plant, space, rng, actions.as_mut(), scratch, path)?;
             if let Some(starts) = starts.as_deref_mut() {
                 starts.extend_from_slice(&buffer[..task_dim]);
             }

@@ -8,7 +8,7 @@ use pyo3::types::PyDict;
 use crate::convert::{config_from, config_to};
 use crate::errors::{guard, to_py};
 use crate::projection::EncoderObject;
-use crate::runner::{RunArgs, gp_map, latent_args, pack_results, run_with_polling};
+use crate::runner::{RunArgs, episodes_in, gp_map, latent_args, pack_results, run_with_polling};
 
 /// Runs Experiment 1 (SPEC §4.1) trials in parallel in Rust and returns their records.
 ///
@@ -106,8 +106,8 @@ pub fn run_bimanual_trials<'py>(
         let (template, _) = bimanual.build(&plant, &config).map_err(to_py)?;
         let options = &run.options;
         crate::runner::check_recording(options, plant.max_steps, 4)?;
-        let results = run_with_polling(py, options, run.progress.as_ref(), |cancel, done| {
-            run_core(&plant, &config, &bimanual, options, cancel, done)
+        let results = run_with_polling(py, episodes_in(options), run.progress.as_ref(), |cancel, done| {
+            run_core(&plant, &config, &bimanual, options, cancel, done).map_err(to_py)
         })?;
         let out = pack_results(py, &results, &template, options, 4)?;
         out.set_item("plant", config_to(py, &plant)?)?;

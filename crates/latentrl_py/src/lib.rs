@@ -38,6 +38,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(bimanual::latent_refusal, m)?)?;
     m.add_function(wrap_pyfunction!(task::bimanual_schema, m)?)?;
     m.add_function(wrap_pyfunction!(task::run_task_trials, m)?)?;
+    m.add_function(wrap_pyfunction!(task::latent_survey, m)?)?;
     m.add_function(wrap_pyfunction!(task::learner_values, m)?)?;
     m.add_function(wrap_pyfunction!(task::task_schema, m)?)?;
     m.add_function(wrap_pyfunction!(task::end_reasons, m)?)?;

@@ -193,21 +193,26 @@ impl<'py> RunArgs<'_, 'py> {
     }
 }
 
-/// Runs `run(cancel, done)` (the trials) on a worker thread; this thread wakes every
-/// [`POLL`], re-attaches, checks for Ctrl-C and reports progress out of
-/// `n_trials × (episodes + test_episodes)`.
-pub(crate) fn run_with_polling<F>(
+/// The units of progress of trials: `n_trials × (episodes + test_episodes)` episodes.
+pub(crate) fn episodes_in(options: &TrialOptions) -> usize {
+    options.n_trials * (options.episodes + options.test_episodes)
+}
+
+/// Runs `run(cancel, done)` (the trials, or any long native call) on a worker thread; this
+/// thread wakes every [`POLL`], re-attaches, checks for Ctrl-C and reports progress, `done`
+/// out of `total`. Ctrl-C sets `cancel` and raises once the worker has stopped.
+pub(crate) fn run_with_polling<T, F>(
     py: Python<'_>,
-    options: &TrialOptions,
+    total: usize,
     progress: Option<&Bound<'_, PyAny>>,
     run: F,
-) -> PyResult<Vec<TrialResult>>
+) -> PyResult<T>
 where
-    F: FnOnce(&AtomicBool, &AtomicUsize) -> latent_core::Result<Vec<TrialResult>> + Send,
+    T: Send,
+    F: FnOnce(&AtomicBool, &AtomicUsize) -> PyResult<T> + Send,
 {
     let cancel = AtomicBool::new(false);
     let done = AtomicUsize::new(0);
-    let total = options.n_trials * (options.episodes + options.test_episodes);
     std::thread::scope(|scope| {
         // Finished also when it panics (a flag set after `run` would never be set).
         let worker = scope.spawn(|| run(&cancel, &done));
@@ -245,9 +250,7 @@ where
         }
         // A panic in the worker (or a rayon thread under it) goes on unwinding here, for the
         // exported function's `guard` to raise as InternalError.
-        let results = joined
-            .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
-            .map_err(to_py)?;
+        let results = joined.unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
         if let Some(cb) = progress {
             cb.call1((done.load(Ordering::Relaxed), total))?;
         }

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
+use ::sim::task::survey::{LearnerGrid, survey};
 use ::sim::task::{
     ConstraintConfig, FallConfig, FloorConfig, ObstacleConfig, Task, TaskConfig, TaskPlant, WaypointConfig,
 };
@@ -19,7 +20,9 @@ use pyo3::types::{PyDict, PyList};
 use crate::convert::{config_from, config_to, points, to_points};
 use crate::errors::{guard, sim_to_py, to_py};
 use crate::projection::EncoderObject;
-use crate::runner::{RunArgs, check_recording, gp_map, invalid, latent_args, pack_results, run_with_polling};
+use crate::runner::{
+    RunArgs, check_recording, episodes_in, gp_map, invalid, latent_args, pack_results, run_with_polling,
+};
 
 /// `classify`'s result: one code per posture and the effector positions.
 type CodesEffectorsTargets<'py> = (
@@ -445,12 +448,68 @@ pub fn run_task_trials<'py>(
         let options = &run.options;
         check_recording(options, rules.max_steps, task.row_len())?;
         let make_plant = |_| TaskPlant::new(Arc::clone(&task), demos.as_deref());
-        let results = run_with_polling(py, options, run.progress.as_ref(), |cancel, done| {
+        let results = run_with_polling(py, episodes_in(options), run.progress.as_ref(), |cancel, done| {
             let make = |trial| make_plant(trial).map_err(|e| latent_core::CoreError::Plant { reason: e.to_string() });
-            latent_core::trials::run_trials(&template, &latent.space(), make, options, cancel, done)
+            latent_core::trials::run_trials(&template, &latent.space(), make, options, cancel, done).map_err(to_py)
         })?;
         let out = pack_results(py, &results, &template, options, task.row_len())?;
         out.set_item("task", config_to(py, task.config())?)?;
+        Ok(out)
+    })
+}
+
+/// The task's latent space at rest (`sim::task::survey`): a grid over [latent_low,
+/// latent_high] at the task's learner step (coarsened to at most `max_points` points), each
+/// point decoded by `decoder` and classified by the task's plant. Returns {shape, stride,
+/// spacing, points (M, d), codes (M,), reward (M,), distance (M,), reached (M,), effectors
+/// (M, 3E), moves (M,): fewest learner moves to the target region, -1 for none}.
+#[pyfunction]
+#[pyo3(signature = (task, *, decoder, latent_low, latent_high, demos = None, max_points = 20_000, progress = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn latent_survey<'py>(
+    py: Python<'py>,
+    task: &PyTask,
+    decoder: Bound<'py, PyAny>,
+    latent_low: &Bound<'py, PyAny>,
+    latent_high: &Bound<'py, PyAny>,
+    demos: Option<PyReadonlyArray2<'py, f64>>,
+    max_points: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    guard(|| {
+        let decoder = Some(decoder);
+        let maps = latent_args(
+            gp_map("decoder", &decoder)?,
+            Some(&()),
+            Some(latent_low),
+            Some(latent_high),
+            "",
+        )?;
+        let demos = rows("demos", demos)?;
+        let task = Arc::clone(&task.inner);
+        TaskPlant::new(Arc::clone(&task), demos.as_deref()).map_err(sim_to_py)?;
+        let at = LearnerGrid::new(&task, &maps.low, &maps.high, max_points).map_err(sim_to_py)?;
+        let s = run_with_polling(py, at.grid.len(), progress.as_ref(), |cancel, done| {
+            survey(&task, demos.as_deref(), maps.decoder, &at, cancel, done).map_err(sim_to_py)
+        })?;
+        let out = PyDict::new(py);
+        let (m, d) = (s.grid.len(), maps.low.len());
+        let mut points = vec![0.0; m * d];
+        for (i, p) in points.chunks_exact_mut(d).enumerate() {
+            s.grid.point(i, p);
+        }
+        out.set_item("shape", s.grid.shape().to_vec())?;
+        out.set_item("stride", s.grid.stride())?;
+        out.set_item("spacing", s.grid.spacing().to_vec())?;
+        out.set_item("points", to_points(py, DMatrix::from_vec(d, m, points))?)?;
+        out.set_item("codes", PyArray1::from_vec(py, s.codes))?;
+        out.set_item("reward", PyArray1::from_vec(py, s.reward))?;
+        out.set_item("distance", PyArray1::from_vec(py, s.distance))?;
+        out.set_item("reached", PyArray1::from_vec(py, s.reached))?;
+        let e = s.effectors.len() / m.max(1);
+        out.set_item("effectors", to_points(py, DMatrix::from_vec(e, m, s.effectors))?)?;
+        let moves: Vec<i64> = s.moves_to_target.iter().map(|x| x.map_or(-1, |v| v as i64)).collect();
+        out.set_item("moves", PyArray1::from_vec(py, moves))?;
         Ok(out)
     })
 }

@@ -15,6 +15,7 @@ use crate::world::WorldConfig;
 
 mod config;
 mod plant;
+pub mod survey;
 pub use config::{
     Axis, ConstraintConfig, ConstraintKind, EpisodeConfig, FallConfig, FloorConfig, ObstacleConfig, ObstacleTest,
     RuleCheck, StartRule, TargetConfig, TaskConfig, TestStart, WaypointConfig,

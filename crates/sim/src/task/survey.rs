@@ -1,0 +1,316 @@
+//! What a task's latent space offers before any training (`latentrl check`): a grid over the
+//! latent box at the learner's own step, each point decoded and put at rest through the task's
+//! plant (the rule it breaks, its reward, its distance to the target, whether it is within the
+//! reach radius), and the fewest learner moves from each point to one within the reach radius
+//! through admissible points.
+//!
+//! A move is judged at rest: it is allowed when the point it lands on is an admissible posture.
+//! What happens on the way (servo lag, a swing through an obstacle between two clear postures)
+//! is the physics' and is not simulated, so a path here is necessary for learning, not
+//! sufficient; a start with no path here has none in training either, up to the grid.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use latent_core::gp::GpMap;
+use latent_core::{Learner, Plant};
+use rayon::prelude::*;
+
+use super::{Task, TaskPlant};
+use crate::error::{Result, SimError};
+
+/// Points a grid holds at most by default: ≈ 10 s of resets on two cores for a floating robot.
+pub const DEFAULT_MAX_POINTS: usize = 20_000;
+
+/// Points classified between two looks at the cancel flag.
+const CHUNK: usize = 64;
+
+/// A regular grid over a latent box, row-major (the last dimension fastest).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LatentGrid {
+    low: Vec<f64>,
+    spacing: Vec<f64>,
+    shape: Vec<usize>,
+    stride: usize,
+}
+
+impl LatentGrid {
+    /// The grid over `[low, high]` whose spacing is `stride` learner steps (`step[k]` per
+    /// dimension), `stride` the smallest ≥ 1 that keeps at most `max_points` points.
+    pub fn at_step(low: &[f64], high: &[f64], step: &[f64], max_points: usize) -> Self {
+        let shape_at = |stride: usize| -> Vec<usize> {
+            low.iter()
+                .zip(high)
+                .zip(step)
+                .map(|((lo, hi), s)| ((hi - lo) / (stride as f64 * s) + 1e-9).floor() as usize + 1)
+                .collect()
+        };
+        let mut stride = 1;
+        while stride < usize::MAX / 2 && shape_at(stride).iter().product::<usize>() > max_points.max(1) {
+            stride += 1;
+        }
+        Self {
+            low: low.to_vec(),
+            spacing: step.iter().map(|s| stride as f64 * s).collect(),
+            shape: shape_at(stride),
+            stride,
+        }
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.shape.iter().product()
+    }
+
+    /// Whether it has no point (never: every dimension has at least one).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Points per dimension.
+    pub fn shape(&self) -> &[usize] {
+        &self.shape
+    }
+
+    /// Learner steps between neighbouring points.
+    pub fn stride(&self) -> usize {
+        self.stride
+    }
+
+    /// Distance between neighbouring points per dimension.
+    pub fn spacing(&self) -> &[f64] {
+        &self.spacing
+    }
+
+    /// The point of `index` into `out`.
+    pub fn point(&self, mut index: usize, out: &mut [f64]) {
+        for k in (0..self.shape.len()).rev() {
+            out[k] = self.low[k] + (index % self.shape[k]) as f64 * self.spacing[k];
+            index /= self.shape[k];
+        }
+    }
+
+    /// The index `offset` points away from `index`, if inside the grid.
+    fn neighbour(&self, index: usize, offset: &[i64]) -> Option<usize> {
+        let (mut rest, mut out, mut scale) = (index, 0, 1);
+        for k in (0..self.shape.len()).rev() {
+            let at = (rest % self.shape[k]) as i64 + offset[k];
+            rest /= self.shape[k];
+            if at < 0 || at >= self.shape[k] as i64 {
+                return None;
+            }
+            out += at as usize * scale;
+            scale *= self.shape[k];
+        }
+        Some(out)
+    }
+}
+
+/// A task's latent space at rest, point by point of a [`LatentGrid`].
+#[derive(Debug, Clone)]
+pub struct Survey {
+    /// The grid.
+    pub grid: LatentGrid,
+    /// Per point: the code of the rule its decoded posture breaks at rest (0: none; 1 obstacle,
+    /// 2 outside the joint limits, 3 drop, 4 fall).
+    pub codes: Vec<u8>,
+    /// Per point: the reward at rest.
+    pub reward: Vec<f64>,
+    /// Per point: the RMS effector distance to the target at rest (m).
+    pub distance: Vec<f64>,
+    /// Per point: admissible and within the reach radius.
+    pub reached: Vec<bool>,
+    /// Per point: the effector positions at rest, (x, y, z) per effector.
+    pub effectors: Vec<f64>,
+    /// Per point: the fewest learner moves (grid moves × stride) to a reached point through
+    /// admissible points; `None` if there is no such path (or the point is not admissible).
+    pub moves_to_target: Vec<Option<usize>>,
+}
+
+/// The grid of a [`survey`] and the learner's moves on it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LearnerGrid {
+    /// The grid, at the learner's step (or `stride` of them).
+    pub grid: LatentGrid,
+    /// The learner's moves as unit offsets on the grid (one grid move = `stride` learner moves).
+    pub moves: Vec<Vec<i64>>,
+}
+
+impl LearnerGrid {
+    /// The grid over `[low, high]` at `task`'s learner step with at most `max_points` points.
+    pub fn new(task: &Task, low: &[f64], high: &[f64], max_points: usize) -> Result<Self> {
+        let learner = Learner::new(&task.config().learner, task.episode_rules(), low, high)
+            .map_err(|e| task_error(task, e.to_string()))?;
+        let d = low.len();
+        // The learner's step per dimension: its largest move along each axis.
+        let displacements = learner.displacements();
+        let step: Vec<f64> = (0..d)
+            .map(|k| displacements.chunks_exact(d).map(|m| m[k].abs()).fold(0.0, f64::max))
+            .collect();
+        let moves = displacements
+            .chunks_exact(d)
+            .map(|m| {
+                m.iter()
+                    .zip(&step)
+                    .map(|(x, s)| if x.abs() > 0.5 * s { x.signum() as i64 } else { 0 })
+                    .collect()
+            })
+            .collect();
+        Ok(Self {
+            grid: LatentGrid::at_step(low, high, &step, max_points),
+            moves,
+        })
+    }
+}
+
+/// Surveys `task`'s latent space of `decoder` on `at` (its grid and the learner's moves);
+/// `demos` as for [`TaskPlant::new`]. Points are classified in parallel, `done` counts them and
+/// `cancel` stops the survey (an error).
+pub fn survey(
+    task: &Arc<Task>,
+    demos: Option<&[Vec<f64>]>,
+    decoder: &GpMap,
+    at: &LearnerGrid,
+    cancel: &AtomicBool,
+    done: &AtomicUsize,
+) -> Result<Survey> {
+    let grid = &at.grid;
+    let d = grid.shape().len();
+    if decoder.input_dim() != d || decoder.output_dim() != task.model().joints().len() {
+        return Err(task_error(
+            task,
+            format!(
+                "the decoder maps {} → {} values; the survey needs {d} → {} (the robot's joints)",
+                decoder.input_dim(),
+                decoder.output_dim(),
+                task.model().joints().len()
+            ),
+        ));
+    }
+    let n = grid.len();
+    let e = 3 * task.config().effectors.len();
+    let chunks: Vec<usize> = (0..n).step_by(CHUNK).collect();
+    let parts = chunks
+        .par_iter()
+        .map_init(
+            || TaskPlant::new(Arc::clone(task), demos),
+            |plant, &start| {
+                let plant = plant.as_mut().map_err(|err| task_error(task, err.to_string()))?;
+                if cancel.load(Ordering::Relaxed) {
+                    return Err(task_error(task, "the survey was cancelled".to_string()));
+                }
+                let (mut z, mut q) = (vec![0.0; d], vec![0.0; decoder.output_dim()]);
+                let mut scratch = decoder.scratch();
+                let end = (start + CHUNK).min(n);
+                let mut part = Part::default();
+                for i in start..end {
+                    grid.point(i, &mut z);
+                    decoder.mean_into(&z, &mut q, &mut scratch);
+                    let code = plant.reset(&q).map_or(0, |r| r.code());
+                    part.codes.push(code);
+                    part.reward.push(plant.reward());
+                    part.distance.push(plant.rms_distance());
+                    part.reached.push(code == 0 && plant.reached_target());
+                    part.effectors.extend_from_slice(&plant.effectors()[..e]);
+                }
+                done.fetch_add(end - start, Ordering::Relaxed);
+                Ok(part)
+            },
+        )
+        .collect::<Result<Vec<Part>>>()?;
+    let mut all = Part::default();
+    for p in parts {
+        all.codes.extend(p.codes);
+        all.reward.extend(p.reward);
+        all.distance.extend(p.distance);
+        all.reached.extend(p.reached);
+        all.effectors.extend(p.effectors);
+    }
+    let moves_to_target = fewest_moves(grid, &all.codes, &all.reached, &at.moves);
+    Ok(Survey {
+        moves_to_target,
+        codes: all.codes,
+        reward: all.reward,
+        distance: all.distance,
+        reached: all.reached,
+        effectors: all.effectors,
+        grid: grid.clone(),
+    })
+}
+
+/// Breadth-first from the reached points backwards along every move: the fewest grid moves
+/// (× the grid's stride) from each admissible point to a reached one.
+fn fewest_moves(grid: &LatentGrid, codes: &[u8], reached: &[bool], offsets: &[Vec<i64>]) -> Vec<Option<usize>> {
+    let mut out = vec![None; grid.len()];
+    let mut queue = VecDeque::new();
+    for (i, _) in reached.iter().enumerate().filter(|(_, r)| **r) {
+        out[i] = Some(0);
+        queue.push_back(i);
+    }
+    let back: Vec<Vec<i64>> = offsets.iter().map(|o| o.iter().map(|x| -x).collect()).collect();
+    while let Some(t) = queue.pop_front() {
+        let next = out[t].map_or(0, |m| m + grid.stride());
+        for o in &back {
+            if let Some(p) = grid.neighbour(t, o)
+                && codes[p] == 0
+                && out[p].is_none()
+            {
+                out[p] = Some(next);
+                queue.push_back(p);
+            }
+        }
+    }
+    out
+}
+
+/// One chunk's per-point results, in point order.
+#[derive(Default)]
+struct Part {
+    codes: Vec<u8>,
+    reward: Vec<f64>,
+    distance: Vec<f64>,
+    reached: Vec<bool>,
+    effectors: Vec<f64>,
+}
+
+fn task_error(task: &Task, reason: String) -> SimError {
+    SimError::Task {
+        origin: task.origin().to_string(),
+        reason,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_grid_at_the_step_and_its_neighbours() {
+        let g = LatentGrid::at_step(&[0.0, -1.0], &[1.0, 1.0], &[0.25, 0.5], 100);
+        assert_eq!((g.shape(), g.stride(), g.len()), (&[5, 5][..], 1, 25));
+        let mut p = [0.0; 2];
+        g.point(7, &mut p);
+        assert_eq!(p, [0.25, 0.0]);
+        assert_eq!(g.neighbour(7, &[1, -1]), Some(11));
+        assert_eq!(g.neighbour(7, &[0, -3]), None);
+        // Coarsened to keep at most 10 points: two steps apart, 3 × 3.
+        let coarse = LatentGrid::at_step(&[0.0, -1.0], &[1.0, 1.0], &[0.25, 0.5], 10);
+        assert_eq!((coarse.shape(), coarse.stride()), (&[3, 3][..], 2));
+    }
+
+    #[test]
+    fn fewest_moves_go_around_what_is_not_admissible() {
+        // 5 × 1 line... as a 1 × 5 grid: target at the right end, a wall at index 2.
+        let g = LatentGrid::at_step(&[0.0], &[4.0], &[1.0], 100);
+        let codes = [0, 0, 1, 0, 0];
+        let reached = [false, false, false, false, true];
+        let m = fewest_moves(&g, &codes, &reached, &[vec![1], vec![-1]]);
+        assert_eq!(m, [None, None, None, Some(1), Some(0)]);
+        let open = fewest_moves(&g, &[0; 5], &reached, &[vec![1], vec![-1]]);
+        assert_eq!(open, [Some(4), Some(3), Some(2), Some(1), Some(0)]);
+        // A one-way action set: only moves to the left; the target is out of reach.
+        let left = fewest_moves(&g, &[0; 5], &reached, &[vec![-1]]);
+        assert_eq!(left, [None, None, None, None, Some(0)]);
+    }
+}

@@ -1,0 +1,282 @@
+"""Will a task learn from these demonstrations? Measured before any training, in seconds
+(`latentrl check`, `Task.check`): each finding is "ok", "warning" or "will not learn", says what
+was measured and, where it can, which key to change to what.
+
+    report = Task.load("my_robot.toml").check(postures)   # a CheckReport
+    print(report)                                           # one line per finding
+    report.verdict                                          # the worst of them
+
+The findings, in order (docs/tasks.md, "Before training: latentrl check"):
+
+- **demos**: rows outside the joint limits, rows that break a rule of the task at rest (an
+  obstacle, a constraint, a fall), and joints whose values look like degrees, by row number;
+- **fit**: whether the GPLVM's optimiser converged;
+- **latent box**: the share of a grid over the latent box, at the learner's own step, whose
+  decoded postures are admissible at rest (the task's plant decides, `sim::task::survey`);
+- **target**: the closest any admissible grid point brings the effectors to the target, against
+  `target.reach_radius`, and how wide the region within it is against the learner's step;
+- **paths**: the share of admissible points from which the learner's own moves reach that
+  region through admissible points (judged at rest: necessary, not sufficient), and the moves it
+  takes against `episode.max_steps`;
+- **servos**: how far the effectors are from each demo's posture after the servos held it
+  0.75 s, against `physics.tolerance`;
+- **cost**: the measured time of an RL step, an episode and the run's budget on this machine.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl import _native
+from latentrl.task import Task, end_reasons
+
+VERDICTS = ("ok", "warning", "will not learn")
+"""Each finding's verdict, mildest first."""
+
+DEGREES = 2 * np.pi + 1e-6
+"""A joint angle beyond ±2π rad is taken for degrees (no robot joint here turns more than once)."""
+
+BROKEN_SHARE = 0.2
+"""Demo rows that break a constraint at rest ("drop"): "will not learn" from this share on, since
+the learner moves on the demos' manifold; other rules (an obstacle touched, a fall, the joint
+limits) and fewer such rows are warnings: the learner can keep off those postures."""
+
+RULE_NAMES = {"box_exit": "outside the joint limits", "drop": "break a constraint", "obstacle": "touch an obstacle",
+              "fall": "fall"}
+"""How the demos finding names the rule a row breaks at rest."""
+
+ADMISSIBLE_SHARE = 0.25
+"""Admissible latent points: a warning below this share of the box ("will not learn" at none)."""
+
+PATH_SHARE = 0.5
+"""Admissible points with a path to the target: a warning below this share."""
+
+HOLD_S = 0.75
+"""Seconds each demo posture is held by the servos before its effectors are compared."""
+
+MOVE_S = 0.25
+"""Seconds the servos take from one demo posture to the next."""
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One measured property of the task, its verdict, what to change and the numbers behind it."""
+
+    name: str
+    verdict: str
+    message: str
+    fix: str | None = None
+    values: dict[str, Any] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """As written to JSON."""
+        return {"name": self.name, "verdict": self.verdict, "message": self.message, "fix": self.fix,
+                "values": self.values}
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """The findings of `check_task`, in order; `verdict` is the worst of them."""
+
+    task: str
+    findings: tuple[Finding, ...]
+
+    @property
+    def verdict(self) -> str:
+        """The worst verdict of the findings."""
+        return max((f.verdict for f in self.findings), key=VERDICTS.index, default="ok")
+
+    def to_dict(self) -> dict[str, Any]:
+        """As written to JSON."""
+        return {"task": self.task, "verdict": self.verdict, "findings": [f.to_dict() for f in self.findings]}
+
+    def __str__(self) -> str:
+        width = max(len(f.name) for f in self.findings)
+        lines = [f"{self.task}: {self.verdict}"]
+        for f in self.findings:
+            lines.append(f"  {f.verdict:14s} {f.name:{width}s}  {f.message}")
+            if f.fix:
+                lines.append(f"  {'':14s} {'':{width}s}  → {f.fix}")
+        return "\n".join(lines)
+
+
+def check_task(task: Task, demos: NDArray[np.float64], model: Any, low: NDArray[np.float64],
+               high: NDArray[np.float64], *, budget: tuple[int, int] = (4, 2000), threads: int = 1,
+               max_points: int = 20_000, progress: Any = None) -> CheckReport:
+    """The findings of the module docs for `task` with `demos` (N, D) in its joint order, the
+    fitted GPLVM `model` and the latent box [`low`, `high`]; `budget` (trials, episodes) is the
+    training run costed, on `threads` threads."""
+    findings = [demo_finding(task, demos), fit_finding(model)]
+    if findings[0].verdict == "will not learn":  # the rest would measure a space the task refuses
+        return CheckReport(task.name, tuple(findings))
+    survey = _native.latent_survey(task._native, decoder=model.decoder_, latent_low=low, latent_high=high,
+                                   demos=demos, max_points=max_points, progress=progress)
+    findings += survey_findings(task, survey)
+    findings.append(servo_finding(task, demos))
+    findings.append(cost_finding(task, demos, budget, threads))
+    return CheckReport(task.name, tuple(findings))
+
+
+def demo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
+    """Degrees, joint limits and the task's rules at rest, row by row."""
+    looks_like_degrees = [name for j, name in enumerate(task.joint_names) if np.abs(demos[:, j]).max() > DEGREES]
+    if looks_like_degrees:
+        worst = float(np.abs(demos).max())
+        return Finding("demos", "will not learn",
+                       f"values up to {worst:.1f} on {', '.join(looks_like_degrees)}: these look like degrees",
+                       "write the demonstrations in radians (np.deg2rad)", {"joints": looks_like_degrees})
+    try:
+        codes, _, _ = task.plant(demos).classify(np.ascontiguousarray(demos))
+    except ValueError as err:  # e.g. the start demo outside the joint limits
+        row = task.to_dict()["episode"]["start_demo"]
+        return Finding("demos", "will not learn", f"row {row} (the home posture, episode.start_demo): {err}",
+                       "fix the demonstrations (or episode.start_demo)")
+    names = end_reasons()
+    broken = {names[c]: np.flatnonzero(codes == c).tolist() for c in np.unique(codes) if c != 0}
+    rows = sorted(r for rs in broken.values() for r in rs)
+    if not rows:
+        return Finding("demos", "ok", f"all {len(demos)} rows are admissible postures at rest")
+    what = "; ".join(f"{RULE_NAMES.get(n, 'break the ' + n + ' rule')}: rows {_rows(r)}" for n, r in broken.items())
+    dropped = len(broken.get("drop", [])) / len(demos)
+    verdict = "will not learn" if dropped >= BROKEN_SHARE else "warning"
+    return Finding("demos", verdict, f"{len(rows)} of {len(demos)} rows {what}",
+                   "remove or fix those rows: the latent space is built from them, and the task refuses them"
+                   + (" (the learner moves on the demos' manifold: most of it breaks the constraint)"
+                      if verdict == "will not learn" else ""),
+                   {"rows": dict(broken)})
+
+
+def fit_finding(model: Any) -> Finding:
+    """Whether the GPLVM fit converged."""
+    if getattr(model, "converged_", True):
+        return Finding("fit", "ok", f"the GPLVM converged in {getattr(model, 'n_iter_', '?')} iterations")
+    return Finding("fit", "warning", f"the GPLVM stopped unconverged after {model.n_iter_} iterations",
+                   f"raise --gplvm-max-iter above {model.n_iter_}", {"n_iter": int(model.n_iter_)})
+
+
+def survey_findings(task: Task, survey: dict[str, Any]) -> list[Finding]:
+    """The latent box, the target and the paths to it, from `_native.latent_survey`."""
+    config = task.to_dict()
+    radius = config["target"]["reach_radius"]
+    codes, distance, moves = survey["codes"], survey["distance"], survey["moves"]
+    admissible = codes == 0
+    shape, stride = tuple(survey["shape"]), int(survey["stride"])
+    share = float(admissible.mean())
+    grid = f"{' × '.join(map(str, shape))} grid at {stride} learner step{'s' if stride > 1 else ''}"
+    if not admissible.any():
+        box = Finding("latent box", "will not learn", f"no point of a {grid} decodes to an admissible posture",
+                      "check the demos against the task's rules (the demos finding) and the latent margin")
+        return [box]
+    box = Finding("latent box", "ok" if share >= ADMISSIBLE_SHARE else "warning",
+                  f"{share:.0%} of a {grid} decode to admissible postures at rest",
+                  None if share >= ADMISSIBLE_SHARE else "a smaller --latent-margin, or demos that span the task",
+                  {"shape": list(shape), "stride": stride, "admissible": share})
+    closest = int(np.flatnonzero(admissible)[np.argmin(distance[admissible])])
+    best = float(distance[closest])
+    where = np.round(survey["points"][closest], 3).tolist()
+    effectors = np.round(survey["effectors"][closest], 3).reshape(-1, 3).tolist()
+    reached = survey["reached"]
+    if not reached.any():
+        target = Finding(
+            "target", "will not learn",
+            f"no admissible latent point is within target.reach_radius = {radius:g} m of the target: the closest "
+            f"is {best:.3f} m away (z = {where}, effectors at {effectors})",
+            f"target.position = {effectors} (reachable), or target.reach_radius = {np.ceil(best * 1000) / 1000:g}, "
+            "or demos that reach the target", {"closest_m": best, "closest_z": where})
+        return [box, target]
+    n_reached = int(reached.sum())
+    isolated = n_reached <= 2 and stride == 1
+    target = Finding(
+        "target", "warning" if isolated else "ok",
+        f"{n_reached} admissible grid points are within {radius:g} m of the target (closest {best * 1000:.1f} mm, "
+        f"best reward {float(survey['reward'][admissible].max()):.3f})"
+        + ("; the region is about one learner step wide, so a step can jump over it" if isolated else ""),
+        f"learner.step = {config['learner']['step'] / 2:g} (half) lands more often inside it" if isolated else None,
+        {"reached_points": n_reached, "closest_m": best})
+    with_path = moves[admissible] >= 0
+    path_share = float(with_path.mean())
+    needed = int(np.percentile(moves[moves >= 0], 95))
+    max_steps = config["episode"]["max_steps"]
+    short = max_steps < needed
+    verdict = "warning" if short or path_share < PATH_SHARE else "ok"
+    fix = []
+    if short:
+        fix.append(f"episode.max_steps = {2 * needed}")
+    if path_share < PATH_SHARE:
+        fix.append("demos that connect the starts with the target, or episode.start that starts nearer it")
+    paths = Finding(
+        "paths", verdict,
+        f"from {path_share:.0%} of the admissible points the learner's moves reach the target through admissible "
+        f"postures (at rest); 95 % of those need ≤ {needed} moves, episode.max_steps = {max_steps}",
+        "; ".join(fix) or None, {"with_path": path_share, "moves_p95": needed, "max_steps": max_steps})
+    return [box, target, paths]
+
+
+def servo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
+    """How far the servos leave the effectors (from the base) from up to 5 admissible demo
+    postures after moving there in `MOVE_S` and holding each `HOLD_S` (the posture put at rest is
+    the reference), against `physics.tolerance` (1 cm if none)."""
+    from latentrl.physics_check import demo_path, track
+
+    plant = task.plant(demos)
+    codes, _, _ = plant.classify(np.ascontiguousarray(demos))
+    admissible = np.flatnonzero(codes == 0)
+    if len(admissible) == 0:
+        return Finding("servos", "warning", "no demo row is an admissible posture to hold", "see the demos finding")
+    order = admissible[np.linspace(0, len(admissible) - 1, min(len(admissible), 5)).round().astype(int)].tolist()
+    at_rest = np.array([_from_base(task, plant, demos[i]) for i in order])
+    plan = demo_path(task, demos, order, move_s=MOVE_S, hold_s=HOLD_S)
+    points, _ = track(task, demos, plan)
+    held = np.round(np.cumsum([HOLD_S] + [MOVE_S + HOLD_S] * (len(order) - 1)) / task.rl_dt).astype(int)
+    held = np.minimum(held, len(points) - 1)
+    reached = points[held, :-1] - points[held, -1:]
+    error = float(np.linalg.norm(reached - at_rest, axis=-1).max())
+    declared = task.to_dict()["physics"]["tolerance"]
+    tolerance = 0.01 if declared is None else declared
+    values = {"error_m": error, "tolerance_m": tolerance}
+    if error <= tolerance:
+        return Finding("servos", "ok", f"the servos hold the demos within {error * 1000:.3g} mm "
+                       f"(tolerance {tolerance * 1000:g} mm)", None, values)
+    return Finding("servos", "warning", f"after {HOLD_S} s the effectors are {error * 1000:.1f} mm from the demo "
+                   f"postures (tolerance {tolerance * 1000:g} mm): the servos do not hold the robot there",
+                   "stiffer servos (servo.kp, with servo.kd about 2·sqrt(kp·inertia)) or higher servo.max_torque",
+                   values)
+
+
+def _from_base(task: Task, plant: Any, posture: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The effectors (E, 3) of `posture` at rest, from the robot's base (a floating robot may
+    stand elsewhere after a walk of servo motions)."""
+    plant.reset(np.ascontiguousarray(posture))
+    row = np.asarray(plant.row())
+    slices = task.row_slices()
+    return np.asarray(row[slices["effectors"]].reshape(-1, 3) - row[slices["base_position"]])
+
+
+def cost_finding(task: Task, demos: NDArray[np.float64], budget: tuple[int, int], threads: int) -> Finding:
+    """The time of an RL step measured along the demos, an episode of `episode.max_steps` steps and
+    the training budget at most."""
+    from latentrl.physics_check import demo_path
+
+    plan = demo_path(task, demos, [0, len(demos) - 1])[:50]
+    plant = task.plant(demos)
+    plant.reset(np.ascontiguousarray(demos[0]))
+    start = time.perf_counter()
+    for target in plan:
+        plant.step(np.ascontiguousarray(target))
+    per_step = (time.perf_counter() - start) / len(plan)
+    max_steps = task.to_dict()["episode"]["max_steps"]
+    trials, episodes = budget
+    run = per_step * max_steps * episodes * trials / max(1, min(threads, trials))
+    return Finding("cost", "ok", f"{per_step * 1e3:.3g} ms per RL step here; an episode ≤ {per_step * max_steps:.3g} s; "
+                   f"{trials} × {episodes} episodes ≤ {run / 60:.3g} min on {threads} thread(s) (episodes ending "
+                   "early cost less)", None, {"rl_step_s": per_step, "budget_s": run})
+
+
+def _rows(rows: list[int], most: int = 10) -> str:
+    shown = ", ".join(map(str, rows[:most]))
+    return shown + (f" … ({len(rows)} rows)" if len(rows) > most else "")

@@ -1,0 +1,96 @@
+"""`latentrl check` (issue #37): before training, whether a task will learn from its demos —
+"ok" on a task that learns, "will not learn" naming the cause for a target outside the decodable
+region, a reach radius smaller than any admissible point gets, and demos that break the task's
+constraint; bad input gets the errors of `train`."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from latentrl import GPLVM, Task, load_demos
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "glass_arm"
+
+
+@pytest.fixture(scope="module")
+def glass():
+    """The README tutorial's glass arm, its demos and a GPLVM of them."""
+    task = Task.load(EXAMPLE / "glass_arm.toml")
+    demos = load_demos(EXAMPLE / "demos.csv", expected_joints=task.joint_names).postures
+    return task, demos, GPLVM(n_components=2, random_state=0).fit(demos)
+
+
+def verdicts(report):
+    return {f.name: f.verdict for f in report.findings}
+
+
+def test_a_task_that_learns_is_ok(glass):
+    """The glass arm learns (tests/test_glass_arm.py): every finding is ok."""
+    task, demos, model = glass
+    report = task.check(demos, model)
+    assert report.verdict == "ok", str(report)
+    assert list(verdicts(report)) == ["demos", "fit", "latent box", "target", "paths", "servos", "cost"]
+    paths = next(f for f in report.findings if f.name == "paths")
+    assert paths.values["with_path"] > 0.9 and paths.values["moves_p95"] < 200
+
+
+def test_a_target_outside_the_decodable_region_will_not_learn(glass):
+    task, demos, model = glass
+    report = task.replace({"target.position": [[0.0, -2.0, 0.0]]}).check(demos, model)
+    target = next(f for f in report.findings if f.name == "target")
+    assert report.verdict == target.verdict == "will not learn"
+    assert "no admissible latent point is within target.reach_radius = 0.05 m" in target.message
+    assert target.values["closest_m"] > 1.0 and "target.position = " in target.fix
+
+
+def test_a_reach_radius_no_admissible_point_gets_will_not_learn(glass):
+    task, demos, model = glass
+    report = task.replace({"target.reach_radius": 1e-5}).check(demos, model)
+    target = next(f for f in report.findings if f.name == "target")
+    assert target.verdict == "will not learn" and f"target.reach_radius = {np.ceil(target.values['closest_m'] * 1000) / 1000:g}" in target.fix
+
+
+def test_demos_that_break_the_constraint_will_not_learn(glass):
+    """Tipping the wrist by 0.5 rad in every row tips the glass past the task's 0.3 rad."""
+    task, demos, _ = glass
+    tipped = demos.copy()
+    tipped[:, -1] += 0.5
+    report = task.check(tipped)
+    found = next(f for f in report.findings if f.name == "demos")
+    assert report.verdict == found.verdict == "will not learn"
+    assert found.message.startswith("80 of 80 rows break a constraint: rows 0, 1, 2")
+
+
+def test_degrees_will_not_learn(glass):
+    task, demos, model = glass
+    found = task.check(np.rad2deg(demos), model).findings[0]
+    assert found.verdict == "will not learn" and "look like degrees" in found.message
+
+
+def latentrl(*args):
+    return subprocess.run([sys.executable, "-m", "latentrl", *args], capture_output=True, text=True, timeout=300)
+
+
+def test_the_cli_prints_json_and_exits_3_when_it_will_not_learn(tmp_path):
+    args = ["check", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--no-progress"]
+    ok = latentrl(*args, "--json")
+    assert ok.returncode == 0, ok.stderr
+    assert json.loads(ok.stdout)["verdict"] == "ok"
+    far = latentrl(*args, "--target.reach-radius", "1e-5")
+    assert far.returncode == 3 and "will not learn" in far.stdout and "target.reach_radius" in far.stdout
+
+
+def test_bad_input_to_check_is_one_line(tmp_path):
+    csv = tmp_path / "demos.csv"
+    csv.write_text("shoulder,elbow,knee\n0.1,0.2,0.3\n0.2,0.3,0.4\n0.3,0.1,0.2\n")
+    result = latentrl("check", str(EXAMPLE / "glass_arm.toml"), "--demos", str(csv))
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and str(csv) in result.stderr
+    result = latentrl("check", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"),
+                      "--learner.alfa", "1")
+    assert result.returncode == 2 and "--learner.alfa" in result.stderr
