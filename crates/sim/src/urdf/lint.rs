@@ -241,7 +241,15 @@ pub(crate) fn scan(xml: &str, origin: &str) -> Result<Scan> {
         }
         let attrs = attributes(tag.attrs);
         let value = |name: &str| attrs.iter().find(|a| a.0 == name).map(|a| a.1);
-        for (name, v, from, to) in &attrs {
+        // What the parser reads: <link>, <joint> and <material> and what they hold (not
+        // <gazebo>, <transmission>, whose `$(find …)` plugin paths are not ours to refuse).
+        let part = if stack.len() == 1 {
+            Some(&tag.name)
+        } else {
+            stack.get(1)
+        };
+        let read = matches!(part, Some(&"link" | &"joint" | &"material"));
+        for (name, v, from, to) in attrs.iter().filter(|_| read) {
             if v.contains("${") {
                 return Err(at(format!("{name}=\"{v}\" is a xacro expression: {RUN_XACRO}")));
             }
@@ -266,7 +274,7 @@ pub(crate) fn scan(xml: &str, origin: &str) -> Result<Scan> {
                 edits.push((tag.attrs_at + from, tag.attrs_at + to, repaired));
             }
         }
-        let in_robot_part = matches!(stack.get(1), Some(&"link" | &"joint"));
+        let in_robot_part = read && part != Some(&"material");
         for (element, attribute, count) in NUMBERS {
             if tag.name != *element || !in_robot_part {
                 continue;
@@ -405,6 +413,9 @@ mod tests {
         assert!(s.warnings[1].starts_with("line 4") && s.warnings[1].contains("$(optenv POS 0.1 0 0.2)"));
         let r = reason("<robot><joint name='j'><origin xyz='$(arg x)'/></joint></robot>");
         assert!(r.contains("xacro substitution"), "{r}");
+        // Not read by the parser: left alone.
+        let gazebo = "<robot><gazebo><plugin filename='$(find pkg)/lib.so' rate='${r}'/></gazebo></robot>";
+        assert!(scan(gazebo, "t").unwrap().warnings.is_empty());
     }
 
     #[test]
