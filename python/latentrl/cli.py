@@ -23,7 +23,7 @@ from latentrl.experiments.presets import field_docs, with_overrides
 from latentrl.experiments.registry import experiments, task_schema
 from latentrl.experiments.results import environment, read_json, write_json
 from latentrl.task import by_path, changed_since
-from latentrl.train import POLICIES
+from latentrl.train import POLICIES, format_rollout
 
 TASK_PREFIX = "task:"
 """Prefix of the argparse destinations of task keys (`task:learner.alpha`)."""
@@ -184,6 +184,10 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     _add_preset_flags(check, TrainRun, exclude=("task_file", "demos", "model"))
     _add_task_flags(check, _native.task_schema())
+    report = sub.add_parser("report", help="the verdict on a trained policy: learnt, stopped improving below the "
+                                           "target, or never reached it, with what to try next")
+    report.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz)")
+    report.add_argument("--json", action="store_true", help="print it as JSON")
     rollout = sub.add_parser("rollout", help="run a trained policy frozen (greedy, soft-max, and the random control from "
                                              "the same starts) and write OUT/rollout.json")
     rollout.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz), or a policy.npz")
@@ -314,7 +318,30 @@ def _train(args: argparse.Namespace) -> int:
     code = _interruptible(lambda: run_training(run, args.out, progress=args.progress), args.out, command)
     if code == 0:
         print(f"trained {run.trials} trial(s) of {run.episodes} episodes; policy in {args.out / 'policy.npz'}")
+        code = _interruptible(lambda: _report_of(args.out, write=True), args.out, command)
     return code
+
+
+def _report_of(out: Path, *, write: bool = False, as_json: bool = False) -> None:
+    """The verdict on the policy in `out` (rollouts from the test starts, the check's advice);
+    printed, and with `write` saved as `out/report.json`."""
+    from latentrl.check import check_task
+    from latentrl.train import LatentPolicy
+    from latentrl.verdict import training_verdict
+
+    policy = LatentPolicy.load(out / "policy.npz")
+    findings = check_task(policy.task, policy.demos, policy.model, policy.latent_low, policy.latent_high)
+    found = training_verdict(policy, findings=findings)
+    if write:
+        write_json(out / "report.json", {**found.to_dict(), "environment": environment()})
+    print(json.dumps(found.to_dict(), indent=2) if as_json else found)
+
+
+def _report(args: argparse.Namespace) -> int:
+    if not (args.results / "policy.npz").is_file():
+        raise ValueError(f"{args.results}: no policy.npz there (a directory of latentrl train)")
+    _report_of(args.results, as_json=args.json)
+    return 0
 
 
 def _check(args: argparse.Namespace) -> int:
@@ -369,14 +396,6 @@ def _rollout(args: argparse.Namespace) -> int:
     for kind, r in results.items():
         print(f"{kind:8s} {format_rollout(r['summary'])}")
     return 0
-
-
-def format_rollout(summary: dict[str, Any]) -> str:
-    """One line of a rollout summary: success, reached at any step, mean return, endings."""
-    success = "-" if summary["success"] is None else f"{summary['success']:.0%}"
-    ends = ", ".join(f"{name} {n}" for name, n in summary["ends"].items() if n)
-    return (f"success {success:>4}  reached (any step) {summary['reached_any_step']:4.0%}  "
-            f"mean return {summary['mean_return']:8.2f}  ends: {ends}")
 
 
 def _policies(text: str) -> list[str]:
@@ -491,7 +510,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command == "info":
         print(json.dumps(environment(), indent=2))
         return 0
-    command = {"run": _run, "train": _train, "check": _check, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep,
+    command = {"run": _run, "train": _train, "check": _check, "report": _report, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep,
                "urdf-info": _urdf_info, "replay": _replay}
     try:
         out = getattr(args, "out", None)

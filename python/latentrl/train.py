@@ -141,6 +141,14 @@ def rollout_summary(ends: NDArray[Any], reached: NDArray[Any], returns: NDArray[
     }
 
 
+def format_rollout(summary: dict[str, Any]) -> str:
+    """One line of a rollout summary: success, reached at any step, mean return, endings."""
+    success = "-" if summary["success"] is None else f"{summary['success']:.0%}"
+    ends = ", ".join(f"{name} {n}" for name, n in summary["ends"].items() if n)
+    return (f"success {success:>4}  reached (any step) {summary['reached_any_step']:4.0%}  "
+            f"mean return {summary['mean_return']:8.2f}  ends: {ends}")
+
+
 RECORD = ("returns", "ends", "reached", "test_returns", "test_ends", "test_reached")
 """What a policy keeps of its training: per episode and per frozen test episode, each (trials, episodes)."""
 

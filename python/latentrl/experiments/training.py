@@ -3,6 +3,7 @@ the one runner (results layout of SPEC §5, resumable) and saved as `DIR/policy.
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -39,9 +40,9 @@ class TrainRun(TrainPreset):
 
 
 @lru_cache(maxsize=2)
-def _load(task_file: str, overrides: tuple[tuple[str, Any], ...], demos: str, model: str,
+def _load(task_file: str, overrides: str, demos: str, model: str,
           seed: int, max_iter: int, encoder: str) -> tuple[Task, np.ndarray, GPLVM]:
-    task = Task.load(task_file).replace(dict(overrides))
+    task = Task.load(task_file).replace(json.loads(overrides))
     loaded = load_demos(demos, min_postures=3)
     postures = task.demo_postures(loaded.joint_names, loaded.postures, demos)
     gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder)
@@ -57,7 +58,7 @@ def fitted(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GP
     """The task (with the run's overrides), the demo postures and the GPLVM (fitted or loaded;
     with `out`, the one saved in that run directory: `latent_runs.run_fit`); cached, so
     validation and setup share the fit."""
-    overrides = tuple(sorted(run.task.items()))
+    overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
     task, demos, model = _load(run.task_file, overrides, run.demos, run.model, run.seed, run.gplvm_max_iter,
                                run.encoder)
     if out is not None:

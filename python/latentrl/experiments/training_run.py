@@ -14,6 +14,7 @@ from latentrl.experiments.presets import latent_box
 from latentrl.experiments.runner import run_rl
 from latentrl.experiments.training import TrainRun, fitted, save_policy, setup
 from latentrl.plots import latent_value_panel, learning_curves, save_figure
+from latentrl.task import end_reasons
 
 
 def run_training(run: TrainRun, out_dir: Path | str, *, progress: bool = True) -> dict[str, Any]:
@@ -41,3 +42,27 @@ def figures(run: TrainRun, arrays: Mapping[str, np.ndarray], run_dir: Path, out:
         latent_value_panel(ax, weights, low, high, model, learner=learner)
         ax.set_title(f"{task.name}: value function {name.split('_')[1]} learning")
         save_figure(fig, out, name)
+    if "latent_mean_state" in arrays:
+        failures(arrays, task.name, low, high, model, learner, out)
+
+
+def failures(arrays: Mapping[str, np.ndarray], name: str, low: np.ndarray, high: np.ndarray, model: Any,
+             learner: Mapping[str, Any], out: Path) -> None:
+    """`failures.png`: trial 0's V after learning with, for each episode of the last fifth of
+    training that never came within the reach radius, its mean latent state, coloured by how it
+    ended (where in the latent space episodes fail)."""
+    trial = 0
+    fifth = max(1, arrays["latent"].shape[1] // 5)
+    means = np.asarray(arrays["latent_mean_state"])[trial, -fifth:]
+    ends = np.asarray(arrays["latent_end"])[trial, -fifth:]
+    failed = ~np.asarray(arrays["latent_reached"], dtype=bool)[trial, -fifth:] & np.isfinite(means).all(axis=1)
+    fig, ax = plt.subplots(figsize=(6, 5))
+    latent_value_panel(ax, np.asarray(arrays["latent_weights"])[trial], low, high, model, learner=learner)
+    for code, reason in enumerate(end_reasons()):
+        mine = failed & (ends == code)
+        if mine.any():
+            ax.plot(means[mine, 0], means[mine, 1], "x", ms=5, color=f"C{code}", label=f"{reason} ({mine.sum()})")
+    if failed.any():
+        ax.legend(fontsize=7, loc="upper right", title="failed, by ending", title_fontsize=7)
+    ax.set_title(f"{name}: where the last {fifth} episodes of trial {trial} failed ({failed.sum()})")
+    save_figure(fig, out, "failures")

@@ -1,0 +1,115 @@
+"""After training: did it learn, and if not, what next? (`latentrl train` ends with it and writes
+`report.json`; `latentrl report DIR` prints it again.)
+
+The measure is the saved policy's rollouts from the task's test starts (`LatentPolicy.rollout`):
+greedy, by the learner's soft-max, and the random control that cannot learn, from the same
+starts. A task "succeeds" in an episode that ends as its success (`target.hold_steps`) or, without
+such a rule, that comes within the reach radius at some step. One of three verdicts:
+
+- **learnt**: the better of greedy and soft-max succeeds in at least `LEARNT` of the rollouts,
+  and more often than the control;
+- **never reached it**: no training episode came within the reach radius;
+- **stopped improving below the target**: anything between.
+
+With the verdict come the endings of the last fifth of the training episodes, whether the reach
+rate was still rising there (more episodes may help), and the next things to try, taken from the
+endings and from `latentrl check`'s findings.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from latentrl.task import end_reasons
+from latentrl.train import format_rollout
+
+LEARNT = 0.8
+"""Success share of the rollouts (greedy or soft-max) from which a policy has "learnt"."""
+
+RISING = 0.05
+"""A reach rate that rose by more than this between the last two tenths of training is still rising."""
+
+ADVICE = {
+    "obstacle": "learner.move_correction = true (moves that meet an obstacle on the way), or a smaller learner.step",
+    "drop": "a smaller learner.step or stiffer servos (the check's servos finding): the constraint breaks on the way",
+    "fall": "a smaller learner.step, or demos that keep the robot balanced (fall.min_start_margin)",
+    "box_exit": "a larger --latent-margin: the learner presses against the latent box's edge",
+    "variance_gate": "a higher learner.variance_threshold, or none",
+}
+"""The next thing to try when most failing late training episodes end this way."""
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """The verdict on a trained policy, with the numbers behind it and what to try next."""
+
+    verdict: str
+    rollouts: dict[str, dict[str, Any]]
+    late_ends: dict[str, int]
+    reach_late: float
+    rising: bool
+    next: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        """As written to report.json."""
+        return {"verdict": self.verdict, "rollouts": self.rollouts, "late_ends": self.late_ends,
+                "reach_late": self.reach_late, "rising": self.rising, "next": self.next}
+
+    def __str__(self) -> str:
+        lines = [f"verdict: {self.verdict}"]
+        lines += [f"  {kind:8s} {format_rollout(summary)}" for kind, summary in self.rollouts.items()]
+        ends = ", ".join(f"{n} {c}" for n, c in self.late_ends.items() if c)
+        lines.append(f"  last fifth of training: reached {self.reach_late:.0%}{' (still rising)' if self.rising else ''};"
+                     f" ends: {ends}")
+        lines += [f"  next: {step}" for step in self.next]
+        return "\n".join(lines)
+
+
+def success_share(summary: dict[str, Any]) -> float:
+    """The share of a rollout's episodes that succeeded: ended as a success, or, without a success
+    rule, came within the reach radius."""
+    return float(summary["reached_any_step"] if summary["success"] is None else summary["success"])
+
+
+def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings: Any = None) -> Verdict:
+    """The verdict of the module docs on `policy` (a LatentPolicy with its training record), from
+    `episodes` rollouts per trial and policy; `findings`: a `check.CheckReport` whose advice joins."""
+    rollouts = {kind: policy.rollout(episodes, seed=seed, policy=kind)["summary"] for kind in ("greedy", "softmax",
+                                                                                               "random")}
+    best = max(success_share(rollouts["greedy"]), success_share(rollouts["softmax"]))
+    control = success_share(rollouts["random"])
+    reached = np.asarray(policy.record["reached"], dtype=bool)
+    ends = np.asarray(policy.record["ends"])
+    n = reached.shape[1]
+    fifth, tenth = max(1, n // 5), max(1, n // 10)
+    reach_late = float(reached[:, -fifth:].mean())
+    rising = n >= 20 and reached[:, -tenth:].mean() > reached[:, -2 * tenth:-tenth].mean() + RISING
+    if best >= LEARNT and best > control:
+        verdict = "learnt"
+    elif not reached.any():
+        verdict = "never reached it"
+    else:
+        verdict = "stopped improving below the target"
+    names = end_reasons()
+    late = ends[:, -fifth:]
+    late_ends = {names[c]: int((late == c).sum()) for c in range(len(names))}
+    steps: list[str] = []
+    if verdict != "learnt":
+        failing = late[~reached[:, -fifth:]]
+        if failing.size:
+            worst = names[int(np.bincount(failing, minlength=len(names)).argmax())]
+            if worst in ADVICE:
+                steps.append(f"most failing episodes end as {worst}: {ADVICE[worst]}")
+            elif worst == "timeout" and reach_late > 0:
+                steps.append("failing episodes time out near the target: a smaller learner.step, so a move can land "
+                             "inside target.reach_radius")
+        if rising:
+            steps.append("the reach rate was still rising at the end: more --episodes")
+        if verdict == "never reached it":
+            steps.append("run latentrl check: its target and paths findings say whether the target can be reached")
+        if findings is not None:
+            steps += [f"{f.name}: {f.fix}" for f in findings.findings if f.verdict != "ok" and f.fix]
+    return Verdict(verdict, rollouts, late_ends, reach_late, bool(rising), steps)
