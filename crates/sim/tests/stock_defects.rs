@@ -221,3 +221,35 @@ fn a_material_inside_geometry_is_dropped_and_reported() {
     );
     assert_eq!(model.visual_shapes().len(), 1);
 }
+
+#[test]
+fn demo_columns_take_any_order_and_check_a_mimic_against_its_leader() {
+    let follower = r#"<joint name="m" type="revolute"><parent link="base"/><child link="b"/><axis xyz="0 0 1"/>
+  <limit lower="-2" upper="2" effort="10" velocity="1"/><mimic joint="ja" multiplier="2" offset="0.1"/></joint>"#;
+    let limit = r#"<limit lower="-1" upper="1" effort="10" velocity="1"/>"#;
+    let xml = robot(&format!(
+        "{}{}{}{}{}{follower}",
+        link("a", INERTIA),
+        link("b", INERTIA),
+        link("c", INERTIA),
+        hinge("ja", "a", limit),
+        hinge("jc", "c", limit)
+    ));
+    let model = load(&xml, false).unwrap();
+    assert_eq!(model.joint_names(), ["ja", "jc"]);
+    let rows = vec![vec![0.3, 1.1, 0.5], vec![-0.2, -0.3, -0.2]];
+    assert_eq!(model.demo_columns(&["jc", "m", "ja"], &rows), Ok(vec![2, 0]));
+    let reason = |names: &[&str], rows: &[Vec<f64>]| match model.demo_columns(names, rows) {
+        Err(SimError::DemoColumns { reason }) => reason,
+        other => panic!("expected a refusal, got {other:?}"),
+    };
+    let off = vec![rows[0].clone(), vec![-0.2, -0.25, -0.2]];
+    let r = reason(&["jc", "m", "ja"], &off);
+    assert!(
+        r.starts_with("row 1: mimic joint \"m\" is -0.25, but 2 * \"ja\""),
+        "{r}"
+    );
+    let r = reason(&["jc", "knee"], &[vec![0.0, 0.0]]);
+    assert!(r.starts_with("missing ['ja'], not joints of the robot ['knee']"), "{r}");
+    assert!(reason(&["ja", "jc", "ja"], &[vec![0.0; 3]]).contains("\"ja\" has two columns"));
+}
