@@ -289,7 +289,7 @@ pub(crate) fn scan(xml: &str, origin: &str) -> Result<Scan> {
             }
             if words.len() != *count {
                 return Err(at(format!(
-                    "{attribute}: {} numbers, expected {count}; correct the file (pybullet reads the first {count})",
+                    "{attribute}: {} numbers, expected {count}; correct the file",
                     words.len()
                 )));
             }
