@@ -1,0 +1,62 @@
+"""Writes demos.csv: up to 120 postures of the Panda-style arm with its gripper pointing down and
+its tool point in the vertical plane x = 0.5 m over y ∈ [-0.42, 0.42], z ∈ [0.05, 0.55] m (drawn
+from a seed); row 0 is the start posture, the tool at (0.5, -0.3, 0.1) in the right bin. Each
+posture is least squares on the plant's own kinematics (tool position, tool axis down, and a
+small pull towards a nominal posture turned to the goal's azimuth, so the demos stay on one
+branch), with the arm's points pushed out of the divider; postures a rule refuses at rest
+(plant.classify) are dropped.
+
+    python examples/zoo/panda_bins/make_demos.py [--seed 0]
+"""
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))
+
+from _zoo import Kin, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
+
+from latentrl import Demonstrations, Task, save_demos  # noqa: E402
+
+DIVIDER = ([0.30, -0.015, 0.0], [0.70, 0.015, 0.22])
+CHAIN = ["panda_link3", "panda_link5", "panda_link7", "panda_hand", "tcp"]
+Q_NOM = np.array([0.0, 0.3, 0.0, -2.1, 0.0, 2.4, 0.785])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args()
+    rng = np.random.default_rng(args.seed)
+    task = Task.load(HERE / "task.toml")
+    kin = Kin(task)
+    n = 140
+    goals = np.column_stack([np.full(n, 0.5), rng.uniform(-0.42, 0.42, n), rng.uniform(0.05, 0.55, n)])
+    goals[0] = [0.5, -0.3, 0.1]
+    Q = []
+    for goal in goals:
+        nominal = Q_NOM + np.array([np.arctan2(goal[1], goal[0]), 0, 0, 0, 0, 0, 0])
+
+        def residual(q: np.ndarray, goal: np.ndarray = goal, nominal: np.ndarray = nominal) -> np.ndarray:
+            poses = kin.poses(q)
+            pen = [box_penetration(p, *DIVIDER, 0.08) for p in chain_points(kin, poses, CHAIN)]
+            return np.concatenate([(kin.pos(poses, "tcp") - goal) / 0.001,
+                                   (kin.axis(poses, "tcp", [0, 0, 1]) - [0, 0, -1]) / 0.01,
+                                   np.array(pen) / 0.001, 0.1 * (q - nominal)])
+
+        q, _ = solve_ik(residual, nominal, kin.lower, kin.upper)
+        if np.linalg.norm(kin.pos(kin.poses(q), "tcp") - goal) < 0.005:
+            Q.append(q)
+        elif len(Q) == 0:
+            raise SystemExit("the start posture (row 0) has no IK solution")
+    postures = keep_admissible(kin, np.array(Q), 120)
+    save_demos(Demonstrations(postures, task.joint_names), HERE / "demos.csv")
+    print(f"{len(postures)} demos -> {HERE / 'demos.csv'}")
+
+
+if __name__ == "__main__":
+    main()
