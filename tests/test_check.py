@@ -94,3 +94,28 @@ def test_bad_input_to_check_is_one_line(tmp_path):
     result = latentrl("check", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"),
                       "--learner.alfa", "1")
     assert result.returncode == 2 and "--learner.alfa" in result.stderr
+
+
+def test_settings_are_derived_where_the_task_is_silent(glass):
+    """`latentrl.derive`: w₀ = 1/(1 − γ); the largest step at which the target region spans ≥ 3
+    steps (the glass arm: 0.5 RBF spacings, what its quick preset had chosen by hand; a 1 cm reach
+    radius needs smaller steps); max_steps from the moves to the target; given keys win."""
+    import tomllib
+
+    from latentrl.derive import derive
+    from latentrl.experiments.presets import latent_box
+
+    task, demos, model = glass
+    low, high = latent_box(model.Z_, 0.1)
+    found = {d.key: d.value for d in derive(task, model, low, high, demos, set(task.given))}
+    assert found == {"learner.initial_weight": pytest.approx(100.0), "learner.step": 0.5}  # max_steps: the file's
+    tight = task.replace({"target.reach_radius": 0.01})
+    assert {d.key: d.value for d in derive(tight, model, low, high, demos, set(tight.given))}["learner.step"] < 0.5
+    written = tomllib.loads((EXAMPLE / "glass_arm.toml").read_text())
+    del written["episode"]["max_steps"], written["learner"]
+    silent = Task.from_dict(written, EXAMPLE)
+    assert "learner.gamma" not in silent.given and "target.width" in silent.given
+    derived = {d.key: d for d in derive(silent, model, low, high, demos, set(silent.given))}
+    assert derived["learner.initial_weight"].value == pytest.approx(1 / (1 - 0.95))
+    assert 50 <= derived["episode.max_steps"].value <= 1000 and "moves" in derived["episode.max_steps"].rule
+    assert derive(task, model, low, high, demos, set(task.given) | {"learner.step", "learner.initial_weight"}) == []

@@ -82,6 +82,9 @@ def test_the_readme_commands_train_save_and_roll_out(runs):
     assert (runs["learner"] / "failures.png").is_file()
     meta = json.loads((runs["learner"] / "results.json").read_text())
     assert meta["preset"]["name"] == "TrainRun" and meta["setup"]["task"]["name"] == "glass_arm"
+    derived = {d["key"]: d["value"] for d in meta["setup"]["derived"]}
+    assert derived == {"learner.initial_weight": pytest.approx(100.0), "learner.step": 0.5}
+    assert meta["setup"]["task"]["learner"]["step"] == 0.5
     assert (runs["learner"] / "policy.npz").is_file() and (runs["learner"] / "returns.png").is_file()
 
 
@@ -126,7 +129,7 @@ def test_a_target_no_episode_reaches_gets_that_verdict_and_what_to_try(tmp_path)
 
 
 def test_a_finished_run_is_not_overwritten_and_resume_keeps_it(runs):
-    train = commands()[0][1:]
+    train = next(c for c in commands() if c[1] == "train")[1:]
     out = str(runs["learner"])
     args = [out if a.startswith("runs/") else a for a in train] + ["--no-progress"]
     result = latentrl(args)

@@ -157,3 +157,17 @@ def test_stock_pybullet_urdfs_load_or_are_refused_saying_where():
     assert loaded == 20
     sdf = urdf_info_cli(str(data / "kuka_iiwa" / "kuka_with_gripper.sdf"))
     assert sdf.returncode == 1 and "an SDF file" in sdf.stderr
+
+
+def test_a_task_takes_balance_inertia_and_names_each_repair(tmp_path):
+    """The task key `balance_inertia = true` loads a robot `urdf-info` repairs, its warnings on the
+    Task (what `latentrl train` and `check` print); without it the task is refused."""
+    zero = LINK.format(name="c", mass=2.0, ixx=0, iyy=0, izz=0)
+    robot(tmp_path, zero + hinge("jc", "c"))
+    text = 'name = "t"\nurdf = "r.urdf"\neffectors = ["c"]\n[target]\nposition = [[0.0, 0.0, 0.0]]\n'
+    (tmp_path / "t.toml").write_text(text)
+    with pytest.raises(ValueError, match="--balance-inertia"):
+        Task.load(tmp_path / "t.toml")
+    (tmp_path / "t.toml").write_text("balance_inertia = true\n" + text)
+    task = Task.load(tmp_path / "t.toml")
+    assert [w.split(":")[0] for w in task.warnings] == ['link "c"'] and "balance_inertia" in task.given

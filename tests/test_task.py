@@ -33,7 +33,7 @@ def test_shipped_tasks_load_with_their_robots():
     lift = Task.shipped("humanoid_lift").to_dict()
     assert lift["root"] == "floating" and lift["floor"] == {"height": 0.0}
     assert lift["fall"]["max_tilt"] == math.radians(20) and lift["servo"]["max_force"] == 1.2
-    assert end_reasons() == ("timeout", "obstacle", "box_exit", "drop", "fall", "variance_gate")
+    assert end_reasons() == ("timeout", "obstacle", "box_exit", "drop", "fall", "variance_gate", "success")
 
 
 @pytest.mark.parametrize(

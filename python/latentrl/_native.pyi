@@ -299,6 +299,9 @@ class Task:
     def collision_shapes(self) -> list[dict[str, Any]]:
         """Every collision shape as a dict (`urdf_info`'s shapes), to draw the robot."""
     @property
+    def warnings(self) -> list[str]:
+        """What loading its URDF repaired, one sentence each."""
+    @property
     def effectors(self) -> list[str]:
         """The names of the task's effectors."""
     @property

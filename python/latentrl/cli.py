@@ -314,6 +314,13 @@ def _train(args: argparse.Namespace) -> int:
     if meta_path.is_file() and not args.resume:
         raise ValueError(f"{args.out} holds a run already: add --resume to continue it, or choose another --out")
     run.validate()  # every file, key and column checked before anything is written
+    from latentrl.experiments.training import prepared
+
+    task, *_, settings = prepared(run)
+    for warning in task.warnings:
+        print(f"latentrl: warning: {warning}", file=sys.stderr)
+    for found in settings:
+        print(f"derived {found.key} = {found.value:g}: {found.rule}")
     command = "the same latentrl train command with --resume"
     code = _interruptible(lambda: run_training(run, args.out, progress=args.progress), args.out, command)
     if code == 0:

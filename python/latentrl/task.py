@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import tomllib
 from collections.abc import Mapping
 from functools import cache
 from importlib import resources
@@ -101,16 +102,21 @@ class Task:
     """A checked task (a thin wrapper of the native `Task`): its configuration, its robot's joint
     names and limits, its effectors; `plant()` builds the native plant that applies its rules."""
 
-    def __init__(self, native: _native.Task, base_dir: Path) -> None:
+    def __init__(self, native: _native.Task, base_dir: Path, given: frozenset[str] = frozenset()) -> None:
         self._native = native
         self.base_dir = base_dir
         """The folder the task's URDF path is relative to (the task file's)."""
+        self.given = given
+        """The keys (by path) its file, dict or overrides set; the others are at their defaults,
+        and `latentrl.derive` may derive them from the data."""
 
     @classmethod
     def load(cls, path: str | Path) -> Task:
         """Reads a TOML task file; an error names the file, the key and the rule (ValueError)."""
         path = Path(path)
-        return cls(_native.Task.load(path), path.parent)
+        native = _native.Task.load(path)  # checked (size, syntax, keys) before it is read here
+        written = key_paths(tomllib.loads(path.read_text()))
+        return cls(native, path.parent, frozenset(written))
 
     @classmethod
     def shipped(cls, name: str) -> Task:
@@ -122,7 +128,7 @@ class Task:
         """A task from a dict of task-file keys (nested tables as dicts); the URDF path is
         relative to `base_dir`."""
         base = Path(base_dir)
-        return cls(_native.Task.from_dict(dict(config), base, origin), base)
+        return cls(_native.Task.from_dict(dict(config), base, origin), base, frozenset(key_paths(config)))
 
     def replace(self, overrides: Mapping[str, Any], origin: str | None = None) -> Task:
         """This task with `overrides` (dotted keys: ``{"learner.alpha": 0.5}``) applied and checked."""
@@ -132,7 +138,8 @@ class Task:
         name = origin or f"{self.origin} with {', '.join(sorted(overrides))}"
         for key, value in overrides.items():
             _set(config, key, value, name)
-        return Task.from_dict(config, self.base_dir, name)
+        native = _native.Task.from_dict(config, self.base_dir, name)
+        return Task(native, self.base_dir, self.given | frozenset(overrides))
 
     def to_dict(self) -> dict[str, Any]:
         """Every key with its effective value: a fresh nested dict of plain values (lists, not
@@ -195,6 +202,12 @@ class Task:
         except ValueError as err:  # InvalidInputError stays one
             raise type(err)(f"{where}: {err}") from err
         return rows[:, columns]
+
+    @property
+    def warnings(self) -> list[str]:
+        """What loading the robot repaired (`balance_inertia = true`: each link's inertia), one
+        sentence each."""
+        return list(self._native.warnings)
 
     @property
     def urdf_path(self) -> Path:

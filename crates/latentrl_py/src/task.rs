@@ -112,6 +112,12 @@ impl PyTask {
         crate::urdf::shape_list(py, &model.collision_shapes(), &model.link_names())
     }
 
+    /// What loading its URDF repaired (`balance_inertia` and the like), one sentence each.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.model().warnings().to_vec()
+    }
+
     /// The names of the task's effectors.
     #[getter]
     fn effectors(&self) -> Vec<String> {

@@ -10,7 +10,7 @@ use latent_core::{EpisodeRules, StartMode};
 
 use crate::error::{Result, SimError};
 use crate::fall::FallCriteria;
-use crate::urdf::UrdfModel;
+use crate::urdf::{LoadOptions, UrdfModel};
 use crate::world::WorldConfig;
 
 mod config;
@@ -65,7 +65,11 @@ impl Task {
         };
         config.validate().map_err(|e| failed(e.to_string()))?;
         let urdf: PathBuf = base_dir.join(&config.urdf);
-        let model = UrdfModel::from_file(&urdf).map_err(|e| failed(format!("urdf: {e}")))?;
+        let options = LoadOptions {
+            balance_inertia: config.balance_inertia,
+        };
+        let model = UrdfModel::from_file_with_options(&urdf, crate::urdf::cache::default_folder().as_deref(), options)
+            .map_err(|e| failed(format!("urdf: {e}")))?;
         Self::new(config, model, origin)
     }
 

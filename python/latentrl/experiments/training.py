@@ -3,6 +3,7 @@ the one runner (results layout of SPEC §5, resumable) and saved as `DIR/policy.
 
 from __future__ import annotations
 
+import hashlib
 import json
 from dataclasses import dataclass
 from functools import lru_cache
@@ -12,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from latentrl.demos import load_demos
+from latentrl.derive import Derived, derive
 from latentrl.experiments.latent_runs import Fitted, latent_setup, run_fit
 from latentrl.experiments.presets import latent_box
 from latentrl.experiments.runner import Setup, finished_trials, load_arrays
@@ -55,21 +57,41 @@ def _load(task_file: str, overrides: str, demos: str, model: str,
 
 
 def fitted(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GPLVM]:
-    """The task (with the run's overrides), the demo postures and the GPLVM (fitted or loaded;
-    with `out`, the one saved in that run directory: `latent_runs.run_fit`); cached, so
-    validation and setup share the fit."""
+    """The task (with the run's overrides and the settings derived where they are silent), the
+    demo postures and the GPLVM (fitted or loaded; with `out`, the one saved in that run
+    directory: `latent_runs.run_fit`); cached, so validation and setup share the fit."""
+    task, demos, model, _ = prepared(run, out)
+    return task, demos, model
+
+
+def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GPLVM, tuple[Derived, ...]]:
+    """`fitted`, and the settings `latentrl.derive` derived for it (cached per task, fit and
+    margin)."""
     overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
     task, demos, model = _load(run.task_file, overrides, run.demos, run.model, run.seed, run.gplvm_max_iter,
                                run.encoder)
     if out is not None:
         model = run_fit(out, run.latent_margin, lambda: Fitted.of_model(model, run.latent_margin)).model
-    return task, demos, model
+    fit = hashlib.sha256(np.ascontiguousarray(model.Z_).tobytes() + np.ascontiguousarray(demos).tobytes())
+    key = (task.digest(), fit.hexdigest(), task.given, run.latent_margin)
+    if key not in _DERIVED:
+        low, high = latent_box(model.Z_, run.latent_margin)
+        _DERIVED[key] = tuple(derive(task, model, low, high, demos, set(task.given)))
+    settings = _DERIVED[key]
+    return task.replace({d.key: d.value for d in settings}, origin=task.origin), demos, model, settings
+
+
+_DERIVED: dict[tuple[Any, ...], tuple[Derived, ...]] = {}
+"""The derived settings per (task digest, fit, given keys, margin)."""
 
 
 def setup(run: TrainRun, out: Path | None = None) -> Setup:
-    """The task's learner on the GPLVM's latent box (the run's in directory `out`)."""
-    task, demos, model = fitted(run, out)
-    return latent_setup(run, task, model, latent_box(model.Z_, run.latent_margin), demos)
+    """The task's learner on the GPLVM's latent box (the run's in directory `out`); results.json
+    records the derived settings (`setup.derived`)."""
+    task, demos, model, settings = prepared(run, out)
+    built = latent_setup(run, task, model, latent_box(model.Z_, run.latent_margin), demos)
+    built.info["derived"] = [d.to_dict() for d in settings]
+    return built
 
 
 def save_policy(run: TrainRun, out: Path) -> LatentPolicy:

@@ -360,6 +360,10 @@ params! {
         name: String = "task".to_string() => Rule::NonEmpty,
         /// The robot's URDF file, relative to the task file.
         urdf: String = String::new() => Rule::NonEmpty,
+        /// Repair inertias the physics cannot take (all zero, or breaking the triangle
+        /// inequality), each repaired link named in the task's warnings (`latentrl urdf-info
+        /// --balance-inertia` shows them; docs/robots.md).
+        balance_inertia: bool = false => Rule::Any,
         /// "fixed" (the root link welded to the world) or "floating" (6 free DoF; needs a floor).
         root: RootMode = RootMode::Fixed => Rule::Any,
         /// A floor (`[floor]`, with its height); a floating robot needs one.

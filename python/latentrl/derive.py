@@ -1,0 +1,97 @@
+"""Settings derived from the demonstrations and the task where the task file and the flags are
+silent (`latentrl train`, `train_latent_policy` on a Task): the paper set its scale parameters by
+hand per experiment; a tool for any robot sets them from what it is given. Each derived value
+comes with its rule; results.json records them (`setup.derived`) and `train` prints them. A key
+the task file or a flag gives always wins; the shipped experiments name theirs.
+
+The rules (docs/tasks.md, "Settings derived from the data"):
+
+- `learner.initial_weight` = 1 / (1 − γ): optimistic, the largest return of rewards ≤ 1, so
+  unvisited states look worth visiting (the quick presets' choice, made a rule);
+- `learner.step`: the largest of 1, 1/2, 1/4, 1/8, 1/16 RBF spacings at which the target region
+  (admissible latent points within `target.reach_radius`, `latentrl check`'s survey) spans at
+  least `SPAN` steps across, so a move can land inside it and stay;
+- `episode.max_steps` = `SLACK` × the moves that 95 % of admissible starts need to the target at
+  that step (at least `MIN_STEPS`, at most the schema's default).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl import _native
+from latentrl.task import Task, schema
+
+STEPS = (1.0, 0.5, 0.25, 0.125, 0.0625)
+"""Learner steps tried, in RBF spacings, largest first."""
+
+SPAN = 3.0
+"""Learner steps the target region must span across (the side of a square of its points)."""
+
+SLACK = 3
+"""Episode length over the moves 95 % of starts need at rest: room to explore and to hold."""
+
+MIN_STEPS = 50
+"""The shortest derived episode."""
+
+
+@dataclass(frozen=True)
+class Derived:
+    """A setting derived where nothing gave it: its key, value and the rule that chose it."""
+
+    key: str
+    value: Any
+    rule: str
+
+    def to_dict(self) -> dict[str, Any]:
+        """As recorded in results.json."""
+        return {"key": self.key, "value": self.value, "rule": self.rule}
+
+
+def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.float64],
+           demos: NDArray[np.float64], given: set[str]) -> list[Derived]:
+    """The settings of the module docs that `given` (the keys the task file and the flags set)
+    leaves open, for `task` in the latent box [`low`, `high`] of `model`."""
+    out = []
+    config = task.to_dict()
+    if "learner.initial_weight" not in given:
+        w0 = 1.0 / (1.0 - config["learner"]["gamma"])
+        out.append(Derived("learner.initial_weight", w0, f"1 / (1 − γ) with γ = {config['learner']['gamma']:g}: "
+                                                          "optimistic, the largest return of rewards ≤ 1"))
+    step = config["learner"]["step"]
+    survey = None
+    if "learner.step" not in given:
+        for candidate in STEPS:
+            found = _survey(task.replace({"learner.step": candidate}), model, low, high, demos)
+            span = _span(found)
+            if span >= SPAN:
+                step, survey = candidate, found
+                out.append(Derived("learner.step", step, f"the largest of {', '.join(f'{s:g}' for s in STEPS)} RBF "
+                                                         f"spacings at which the target region spans ≥ {SPAN:g} steps "
+                                                         f"(it spans {span:.1f})"))
+                break
+    if "episode.max_steps" not in given:
+        survey = survey or _survey(task.replace({"learner.step": step}), model, low, high, demos)
+        moves = survey["moves"][survey["moves"] >= 0]
+        if len(moves):
+            default = next(e["default"] for e in schema() if e["key"] == "episode.max_steps")
+            needed = int(np.percentile(moves, 95))
+            value = int(min(default, max(MIN_STEPS, SLACK * needed)))
+            out.append(Derived("episode.max_steps", value, f"{SLACK} × the {needed} moves 95 % of admissible starts "
+                                                           f"need to the target at rest (in [{MIN_STEPS}, {default}])"))
+    return out
+
+
+def _survey(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.float64],
+            demos: NDArray[np.float64]) -> dict[str, Any]:
+    return _native.latent_survey(task._native, decoder=model.decoder_, latent_low=low, latent_high=high, demos=demos)
+
+
+def _span(survey: dict[str, Any]) -> float:
+    """Learner steps the target region spans across: the side of a square (cube…) of its points."""
+    reached = int(np.asarray(survey["reached"]).sum())
+    return float(reached ** (1 / len(survey["shape"])) * survey["stride"]) if reached else 0.0
