@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from latentrl import GPLVM, Task, load_demos
+from latentrl.check import check
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "glass_arm"
@@ -32,7 +33,7 @@ def verdicts(report):
 def test_a_task_that_learns_is_ok(glass):
     """The glass arm learns (tests/test_glass_arm.py): every finding is ok."""
     task, demos, model = glass
-    report = task.check(demos, model)
+    report = check(task, demos, model)
     assert report.verdict == "ok", str(report)
     assert list(verdicts(report)) == ["demos", "fit", "latent box", "target", "paths", "servos", "cost"]
     paths = next(f for f in report.findings if f.name == "paths")
@@ -41,7 +42,7 @@ def test_a_task_that_learns_is_ok(glass):
 
 def test_a_target_outside_the_decodable_region_will_not_learn(glass):
     task, demos, model = glass
-    report = task.replace({"target.position": [[0.0, -2.0, 0.0]]}).check(demos, model)
+    report = check(task.replace({"target.position": [[0.0, -2.0, 0.0]]}), demos, model)
     target = next(f for f in report.findings if f.name == "target")
     assert report.verdict == target.verdict == "will not learn"
     assert "no admissible latent point is within target.reach_radius = 0.05 m" in target.message
@@ -50,7 +51,7 @@ def test_a_target_outside_the_decodable_region_will_not_learn(glass):
 
 def test_a_reach_radius_no_admissible_point_gets_will_not_learn(glass):
     task, demos, model = glass
-    report = task.replace({"target.reach_radius": 1e-5}).check(demos, model)
+    report = check(task.replace({"target.reach_radius": 1e-5}), demos, model)
     target = next(f for f in report.findings if f.name == "target")
     assert target.verdict == "will not learn" and f"target.reach_radius = {np.ceil(target.values['closest_m'] * 1000) / 1000:g}" in target.fix
 
@@ -60,7 +61,7 @@ def test_demos_that_break_the_constraint_will_not_learn(glass):
     task, demos, _ = glass
     tipped = demos.copy()
     tipped[:, -1] += 0.5
-    report = task.check(tipped)
+    report = check(task, tipped)
     found = next(f for f in report.findings if f.name == "demos")
     assert report.verdict == found.verdict == "will not learn"
     assert found.message.startswith("80 of 80 rows break a constraint: rows 0, 1, 2")
@@ -68,7 +69,7 @@ def test_demos_that_break_the_constraint_will_not_learn(glass):
 
 def test_degrees_will_not_learn(glass):
     task, demos, model = glass
-    found = task.check(np.rad2deg(demos), model).findings[0]
+    found = check(task, np.rad2deg(demos), model).findings[0]
     assert found.verdict == "will not learn" and "look like degrees" in found.message
 
 

@@ -1,8 +1,9 @@
 """Will a task learn from these demonstrations? Measured before any training, in seconds
-(`latentrl check`, `Task.check`): each finding is "ok", "warning" or "will not learn", says what
+(`latentrl check`, `latentrl.check.check`): each finding is "ok", "warning" or "will not learn", says what
 was measured and, where it can, which key to change to what.
 
-    report = Task.load("my_robot.toml").check(postures)   # a CheckReport
+    from latentrl.check import check
+    report = check(Task.load("my_robot.toml"), postures)   # a CheckReport
     print(report)                                           # one line per finding
     report.verdict                                          # the worst of them
 
@@ -103,6 +104,25 @@ class CheckReport:
             if f.fix:
                 lines.append(f"  {'':14s} {'':{width}s}  → {f.fix}")
         return "\n".join(lines)
+
+
+def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | None = None) -> CheckReport:
+    """Will `task` learn from `demos` (N, D postures in its joint order)? The findings of the
+    module docs; `model`: a fitted GPLVM (default: one fitted here, d = 2, seed 0, as `train`
+    fits); `latent_margin`: the box's margin (default: `TrainPreset`'s)."""
+    from latentrl.experiments.presets import latent_box
+    from latentrl.gplvm import GPLVM
+    from latentrl.train import TrainPreset
+
+    postures = np.ascontiguousarray(demos, dtype=np.float64)
+    if postures.ndim != 2 or postures.shape[1] != len(task.joint_names) or not np.isfinite(postures).all():
+        raise ValueError(f"demos: expected finite postures of shape (N, {len(task.joint_names)}) for {task.name}, "
+                         f"got {postures.shape}")
+    preset = TrainPreset()
+    if model is None:
+        model = GPLVM(n_components=2, random_state=0, max_iter=preset.gplvm_max_iter).fit(postures)
+    low, high = latent_box(model.Z_, preset.latent_margin if latent_margin is None else latent_margin)
+    return check_task(task, postures, model, low, high, budget=(preset.trials, preset.episodes))
 
 
 def check_task(task: Task, demos: NDArray[np.float64], model: Any, low: NDArray[np.float64],

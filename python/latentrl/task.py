@@ -159,27 +159,6 @@ class Task:
         rows = None if demos is None else np.ascontiguousarray(demos, dtype=np.float64)
         return _native.TaskPlant(self._native, rows)
 
-    def check(self, demos: Any, model: Any = None, *, latent_margin: float | None = None) -> Any:
-        """Will this task learn from `demos` (N, D postures in joint order)? A
-        `latentrl.check.CheckReport` of findings measured before training (`latentrl check`): the
-        demos against the task's rules, the fit, the latent box, the target, the paths to it, the
-        servos and the cost. `model`: a fitted GPLVM (default: one fitted here, d = 2, seed 0);
-        `latent_margin`: the box's margin (default: `TrainPreset`'s)."""
-        from latentrl.check import check_task
-        from latentrl.experiments.presets import latent_box
-        from latentrl.gplvm import GPLVM
-        from latentrl.train import TrainPreset
-
-        postures = np.ascontiguousarray(demos, dtype=np.float64)
-        if postures.ndim != 2 or postures.shape[1] != len(self.joint_names) or not np.isfinite(postures).all():
-            raise ValueError(f"demos: expected finite postures of shape (N, {len(self.joint_names)}) for {self.name}, "
-                             f"got {postures.shape}")
-        preset = TrainPreset()
-        if model is None:
-            model = GPLVM(n_components=2, random_state=0, max_iter=preset.gplvm_max_iter).fit(postures)
-        low, high = latent_box(model.Z_, preset.latent_margin if latent_margin is None else latent_margin)
-        return check_task(self, postures, model, low, high, budget=(preset.trials, preset.episodes))
-
     def check_joints(self, joint_names: tuple[str, ...] | list[str], where: str) -> None:
         """ValueError naming `where` unless `joint_names` are this robot's actuated joints in order."""
         expected = list(self.joint_names)
