@@ -127,3 +127,34 @@ def test_bad_rerun_requests_are_named(runs, tmp_path, capsys):
     err = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert err.returncode == 1 and "pip install 'latentrl[viewer]'" in err.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_lifting_arm_is_seen_from_the_side_and_its_height_changes_the_picture():
+    """Issue #41: a 3-D arm whose target is above it was drawn top-down (x–y), where a lift does
+    not show. The default view keeps the two axes its links and target spread over most; the
+    image changes with the effector's height; `view` picks one by name."""
+    from pathlib import Path
+
+    from latentrl import Task
+    from latentrl.render import VIEWS, draw_task, view_axes
+
+    arm7 = Path(__file__).parent / "robots" / "arm7_description" / "urdf" / "arm7.urdf"
+    task = Task.from_dict({"name": "lift", "urdf": str(arm7), "root": "fixed", "effectors": ["tcp"],
+                           "target": {"position": [[0.5, 0.0, 0.9]]}})
+    plant = task.plant()
+    low, high = np.nan_to_num(task.lower, neginf=-1.0), np.nan_to_num(task.upper, posinf=1.0)
+    bent = np.clip(np.array([0.0, 0.9, 0.0, -1.5, 0.0, 1.8, 0.0, 0.0, 0.0][: len(low)]), low, high)
+    raised = bent.copy()
+    raised[1] = np.clip(0.2, low[1], high[1])  # the shoulder lifts the hand
+    images, heights = [], []
+    for posture in (bent, raised):
+        assert plant.reset(posture) is None
+        heights.append(float(plant.effectors()[2]))
+        poses = np.asarray(plant.link_poses())
+        assert 2 in view_axes(task, poses[:, :3], np.asarray(plant.target_position()))
+        images.append(draw_task(task, plant, size=200))
+    assert abs(heights[1] - heights[0]) > 0.05
+    assert not np.array_equal(images[0], images[1])
+    assert view_axes(task, np.zeros((1, 3)), np.zeros((1, 3)), "top") == VIEWS["top"] == (0, 1)
+    with pytest.raises(ValueError, match="view must be one of top, side, front"):
+        draw_task(task, plant, view="3d")

@@ -236,6 +236,9 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")
     replay.add_argument("--width", type=int, default=960, help="frame width in pixels, height half of it (default 960)")
     replay.add_argument("--max-frames", type=int, default=400, help="at most this many frames, evenly spaced over the episode (default 400)")
+    replay.add_argument("--view", choices=("top", "side", "front"),
+                        help="the robot seen from the top (x-y), the side (x-z) or the front (y-z); default: the side of a "
+                             "floating robot, else the plane its links and target spread over most")
     urdf = sub.add_parser("urdf-info", help="what a URDF holds as the physics loads it: joints, links, collision shapes, mass")
     urdf.add_argument("urdf", type=Path, help="the robot's URDF file")
     urdf.add_argument("--json", action="store_true", help="print it as JSON instead of a table")
@@ -482,7 +485,7 @@ def _replay(args: argparse.Namespace) -> int:
 
     name, preset = saved_run(args.results, train=True)
     what = replay(args.results, name, preset, args.out, rerun=args.rerun, trial=args.trial, episode=args.episode,
-                  test=args.test, fps=args.fps, width=args.width, max_frames=args.max_frames)
+                  test=args.test, fps=args.fps, width=args.width, max_frames=args.max_frames, view=args.view)
     print(what)
     return 0
 

@@ -193,7 +193,8 @@ class TaskEnv(gym.Env[Obs, Obs]):
 
     def render(self) -> NDArray[np.uint8] | None:
         """An RGB image (H, W, 3) of the robot's links, the target and the floor if `render_mode`
-        is ``"rgb_array"``, else None: the x–z side view of a floating robot, x–y for a fixed one."""
+        is ``"rgb_array"``, else None: the x–z side view of a floating robot; for a fixed one the plane
+        its links and target spread over most (`latentrl.render.view_axes`)."""
         if self.render_mode != "rgb_array":
             return None
         from latentrl.render import draw_task

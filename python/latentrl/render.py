@@ -1,6 +1,7 @@
 """Pictures of a task's robot from the native plant's link poses (`render_mode="rgb_array"`):
-the kinematic tree, the effectors' target, the obstacles and the floor, in the x–z side view
-of a floating robot or the x–y view of a fixed one; needs matplotlib (the `[plot]` extra)."""
+the kinematic tree, the effectors' target, the obstacles and the floor, seen from the top, the
+side or the front (by default the side of a floating robot, and for a fixed one the plane its
+links and target spread over most); needs matplotlib (the `[plot]` extra)."""
 
 from __future__ import annotations
 
@@ -30,15 +31,33 @@ def _pixels(fig: Any) -> NDArray[np.uint8]:
     return np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
 
 
-def view_axes(task: Task) -> tuple[int, int]:
-    """The world axes drawn: (x, z) for a floating robot, (x, y) for a fixed one."""
-    return (0, 2) if task.to_dict()["root"] == "floating" else (0, 1)
+VIEWS = {"top": (0, 1), "side": (0, 2), "front": (1, 2)}
+"""The views by name: the world axes each draws (top x–y, side x–z, front y–z)."""
 
 
-def draw_task(task: Task, plant: _native.TaskPlant, size: int = 400) -> NDArray[np.uint8]:
-    """An RGB image (size, size, 3) of the task's robot as the plant holds it now."""
+def view_axes(task: Task, points: NDArray[np.float64], target: NDArray[np.float64], view: str | None = None) -> tuple[int, int]:
+    """The world axes drawn: `view`'s (`VIEWS`), or by default the side view (x–z) of a floating
+    robot and, for a fixed one, the two axes along which its links (`points`, (K, 3): where they
+    are, or go over an episode) and the target spread most: a planar arm in its plane, an arm that
+    lifts from the side, so the motion that matters is seen."""
+    if view is not None:
+        if view not in VIEWS:
+            raise ValueError(f"view must be one of {', '.join(VIEWS)}, got {view!r}")
+        return VIEWS[view]
+    if task.to_dict()["root"] == "floating":
+        return VIEWS["side"]
+    every = np.vstack([points[np.isfinite(points).all(axis=1)], target])
+    spread = every.max(axis=0) - every.min(axis=0)
+    kept = sorted(np.argsort(spread)[1:].tolist())
+    return int(kept[0]), int(kept[1])
+
+
+def draw_task(task: Task, plant: _native.TaskPlant, size: int = 400, view: str | None = None) -> NDArray[np.uint8]:
+    """An RGB image (size, size, 3) of the task's robot as the plant holds it now, in `view`
+    (`view_axes`)."""
     fig, ax = _canvas(size)
-    draw_scene(ax, Scene.of(task, plant), np.asarray(plant.link_poses()))
+    poses = np.asarray(plant.link_poses())
+    draw_scene(ax, Scene.of(task, plant, poses[:, :3], view), poses)
     return _pixels(fig)
 
 
@@ -55,12 +74,13 @@ class Scene:
     target: NDArray[np.float64]
 
     @classmethod
-    def of(cls, task: Task, plant: _native.TaskPlant) -> Scene:
+    def of(cls, task: Task, plant: _native.TaskPlant, points: NDArray[np.float64], view: str | None = None) -> Scene:
         """The scene of `task`, its target where `plant` holds it now (a target measured from a
-        link, `target.relative_to`, moves with it)."""
+        link, `target.relative_to`, moves with it), seen in `view` or the view that shows the
+        links' `points` (K, 3) and the target best (`view_axes`)."""
         config = task.to_dict()
         target = np.asarray(plant.target_position(), dtype=np.float64)
-        return cls(view_axes(task), config, tuple(task.link_names), tuple(task.edges),
+        return cls(view_axes(task, points, target, view), config, tuple(task.link_names), tuple(task.edges),
                    tuple(task._native.collision_shapes()), target)
 
 

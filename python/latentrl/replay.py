@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl._base import atomic_path
+from latentrl.render import VIEWS
 
 #: What `replay` writes, by suffix.
 FORMATS = (".gif", ".mp4")
@@ -84,9 +85,9 @@ class Recorded:
 
 
 def recorded(experiment: str, preset: Any, run_dir: Path, rows: NDArray[np.float64], weights: NDArray[np.float64],
-             title: str) -> Recorded:
+             title: str, view: str | None = None) -> Recorded:
     """The episode of stored `rows` of the run of `experiment` in `run_dir`, with the GPLVM saved
-    there (`latent_runs.run_fit`)."""
+    there (`latent_runs.run_fit`), the robot seen in `view` (`render.view_axes`)."""
     from latentrl.render import Scene
 
     if experiment == "exp1":
@@ -104,7 +105,7 @@ def recorded(experiment: str, preset: Any, run_dir: Path, rows: NDArray[np.float
     plant = task.plant()
     poses = np.stack([np.asarray(plant.pose_links(b, q)) for b, q in zip(base, joints)])
     plant.pose_links(base[0], joints[0])
-    scene = Scene.of(task, plant)  # the target where it stands at the episode's start
+    scene = Scene.of(task, plant, poses[..., :3].reshape(-1, 3), view)  # the target where it stands at the start
     return Recorded(f"{task.name}: {title}", rows[:, slices["effectors"]].reshape(len(rows), -1, 3),
                     model.transform(joints), weights, low, high, model, scene.config["learner"], scene=scene,
                     poses=poses)
@@ -197,7 +198,7 @@ def run_setup(experiment: str, preset: Any, run_dir: Path) -> tuple[Any, Any, tu
 
 def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None, *, rerun: Path | None = None,
            trial: int = 0, episode: int | None = None, test: int | None = None, fps: int = 20, width: int = 960,
-           max_frames: int = 400) -> str:
+           max_frames: int = 400, view: str | None = None) -> str:
     """Renders one recorded episode of the run in `run_dir` (`experiment` "exp1", "exp2", "exp3"
     or "train", its saved `preset`) to the video `out` and/or the Rerun recording `rerun`;
     returns what was rendered. Every argument is checked before drawing."""
@@ -213,6 +214,8 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     for flag, value, least in (("--fps", fps, 1), ("--width", width, 200), ("--max-frames", max_frames, 2)):
         if value < least:
             raise ValueError(f"{flag} must be at least {least}, got {value}")
+    if view is not None and view not in VIEWS:
+        raise ValueError(f"--view must be one of {', '.join(VIEWS)}, got {view!r}")
     if out is not None:
         check_output(out)
     if rerun is not None:
@@ -224,7 +227,7 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     weights = arrays.get("latent_weights")
     if weights is None:
         raise ValueError(f"{run_dir}: the run kept no learnt weights to draw V from")
-    drawn = recorded(experiment, preset, run_dir, rows, np.asarray(weights)[trial], what)
+    drawn = recorded(experiment, preset, run_dir, rows, np.asarray(weights)[trial], what, view)
     done = []
     if out is not None:
         frames = render_frames(drawn, size=(width, width // 2), max_frames=max_frames)
