@@ -78,6 +78,23 @@ def test_a_latentrl_train_run_on_a_custom_task_replays(tmp_path):
     out = tmp_path / "glass.gif"
     assert main(["replay", str(run), "--test", "0", "--out", str(out)]) == 0
     assert iio.imread(out).shape[1:] == (480, 960, 3)
+    # Issue #41: a rollout is saved in a layout replay reads, each policy's episodes.
+    rolled = tmp_path / "rolled"
+    assert main(["rollout", str(run), "--out", str(rolled), "--episodes", "2", "--no-progress"]) == 0
+    for policy in ("greedy", "random"):
+        video = tmp_path / f"{policy}.gif"
+        assert main(["replay", str(rolled), "--episode", "1", "--policy", policy, "--out", str(video)]) == 0
+        with np.load(rolled / "rollout.npz") as npz:
+            rows = np.isfinite(npz[f"{policy}_paths"][0, 1]).all(axis=1).sum()
+        assert iio.imread(video).shape == (rows, 480, 960, 3)
+    moved = tmp_path / "moved"
+    moved.mkdir()
+    run.rename(moved / "glass")
+    rolled.rename(moved / "rolled")
+    rolled = moved / "rolled"
+    assert main(["replay", str(rolled), "--episode", "0", "--out", str(tmp_path / "moved.gif")]) == 0
+    assert main(["replay", str(rolled), "--episode", "5", "--out", str(tmp_path / "x.gif")]) == 1
+    assert not (tmp_path / "x.gif").exists()
 
 
 def test_a_training_episode_of_exp1s_latent_learner_becomes_a_gif(runs):

@@ -226,7 +226,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     sub.add_parser("info", help="print versions, git revision and thread count as JSON")
     replay = sub.add_parser("replay", help="render a recorded episode of an Exp 1, Exp 2, Exp 3 or latentrl train run to a GIF or MP4 (the [video] extra) or a Rerun recording (the [viewer] extra)")
-    replay.add_argument("results", type=Path, help="a results directory of latentrl run exp1|exp2|exp3 or latentrl train")
+    replay.add_argument("results", type=Path, help="a results directory of latentrl run exp1|exp2|exp3, latentrl train "
+                                                     "or latentrl rollout")
     replay.add_argument("--out", type=Path, help="the video: FILE.gif or FILE.mp4")
     replay.add_argument("--rerun", type=Path, help="a Rerun recording FILE.rrd (view it with `rerun FILE.rrd`)")
     which = replay.add_mutually_exclusive_group(required=True)
@@ -236,6 +237,8 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_argument("--fps", type=int, default=20, help="frames per second (default 20)")
     replay.add_argument("--width", type=int, default=960, help="frame width in pixels, height half of it (default 960)")
     replay.add_argument("--max-frames", type=int, default=400, help="at most this many frames, evenly spaced over the episode (default 400)")
+    replay.add_argument("--policy", choices=POLICIES, default="greedy",
+                        help="of a rollout directory: which policy's episode (default: greedy)")
     replay.add_argument("--view", choices=("top", "side", "front"),
                         help="the robot seen from the top (x-y), the side (x-z) or the front (y-z); default: the side of a "
                              "floating robot, else the plane its links and target spread over most")
@@ -399,7 +402,8 @@ def _rollout(args: argparse.Namespace) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     write_npz(args.out / "rollout.npz", {f"{kind}_{k}": r[k] for kind, r in results.items()
                                          for k in ("returns", "ends", "reached", "paths")})
-    summary = {"policy": str(path.resolve()), "task": policy.task.name, "trials": next(iter(results.values()))["trials"],
+    summary = {"policy": str(path.resolve()), "policy_from_out": os.path.relpath(path.resolve(), args.out.resolve()),
+               "task": policy.task.name, "trials": next(iter(results.values()))["trials"],
                "episodes": args.episodes, "seed": args.seed, "starts": args.starts,
                **{kind: r["summary"] for kind, r in results.items()}, "environment": environment()}
     write_json(args.out / "rollout.json", summary)
@@ -481,8 +485,15 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _replay(args: argparse.Namespace) -> int:
-    from latentrl.replay import replay
+    from latentrl.replay import check_request, render, replay, rollout_episode
 
+    if (args.results / "rollout.json").is_file():  # a `latentrl rollout` directory
+        if args.episode is None:
+            raise ValueError(f"{args.results} holds a rollout: give --episode E (and --policy)")
+        check_request(args.out, args.rerun, args.fps, args.width, args.max_frames, args.view)
+        drawn = rollout_episode(args.results, args.policy, args.trial, args.episode, args.view)
+        print(render(drawn, args.out, args.rerun, fps=args.fps, width=args.width, max_frames=args.max_frames))
+        return 0
     name, preset = saved_run(args.results, train=True)
     what = replay(args.results, name, preset, args.out, rerun=args.rerun, trial=args.trial, episode=args.episode,
                   test=args.test, fps=args.fps, width=args.width, max_frames=args.max_frames, view=args.view)

@@ -88,8 +88,6 @@ def recorded(experiment: str, preset: Any, run_dir: Path, rows: NDArray[np.float
              title: str, view: str | None = None) -> Recorded:
     """The episode of stored `rows` of the run of `experiment` in `run_dir`, with the GPLVM saved
     there (`latent_runs.run_fit`), the robot seen in `view` (`render.view_axes`)."""
-    from latentrl.render import Scene
-
     if experiment == "exp1":
         from latentrl.experiments import exp1
 
@@ -99,10 +97,20 @@ def recorded(experiment: str, preset: Any, run_dir: Path, rows: NDArray[np.float
         return Recorded(title, hands, fitted.model.transform(rows), weights, fitted.low, fitted.high, fitted.model,
                         learner, toy=plant)
     task, model, (low, high) = run_setup(experiment, preset, run_dir)
+    return robot_episode(task, model, low, high, rows, weights, title, view)
+
+
+def robot_episode(task: Any, model: Any, low: NDArray[np.float64], high: NDArray[np.float64],
+                  rows: NDArray[np.float64], weights: NDArray[np.float64], title: str,
+                  view: str | None = None, demos: NDArray[np.float64] | None = None) -> Recorded:
+    """The episode of stored path `rows` of `task`'s robot (its plant built with `demos`) in the
+    latent box [`low`, `high`] of `model`, on the V of `weights`, seen in `view`."""
+    from latentrl.render import Scene
+
     slices = task.row_slices()
     joints = rows[:, slices["joints"]]
     base = rows[:, np.r_[slices["base_position"], slices["base_quaternion"]]]
-    plant = task.plant()
+    plant = task.plant(demos)
     poses = np.stack([np.asarray(plant.pose_links(b, q)) for b, q in zip(base, joints)])
     plant.pose_links(base[0], joints[0])
     scene = Scene.of(task, plant, poses[..., :3].reshape(-1, 3), view)  # the target where it stands at the start
@@ -196,6 +204,31 @@ def run_setup(experiment: str, preset: Any, run_dir: Path) -> tuple[Any, Any, tu
     return module.task_of(preset), fit.model, (fit.low, fit.high)
 
 
+def rollout_episode(out: Path, policy: str, trial: int, episode: int, view: str | None = None) -> Recorded:
+    """Episode `episode` of trial `trial` of the `policy` ("greedy", "softmax", "random") rollout
+    that `latentrl rollout` wrote into `out`, with the saved policy it names."""
+    from latentrl.experiments.results import read_json
+    from latentrl.train import POLICIES, LatentPolicy
+
+    meta = read_json(out / "rollout.json")
+    if policy not in POLICIES or policy not in meta:
+        ran = [p for p in POLICIES if p in meta]
+        raise ValueError(f"--policy {policy}: the rollout in {out} ran {', '.join(ran)}")
+    trials = list(meta["trials"])
+    if trial not in trials:
+        raise ValueError(f"--trial {trial}: the rollout ran trials {trials}")
+    moved = out / meta.get("policy_from_out", "")  # the rollout and its run moved together
+    saved = LatentPolicy.load(moved if moved.is_file() else Path(meta["policy"]))
+    with np.load(out / "rollout.npz") as npz:
+        paths = npz[f"{policy}_paths"][trials.index(trial)]
+    if not 0 <= episode < len(paths):
+        raise ValueError(f"--episode {episode}: the rollout recorded episodes 0..{len(paths) - 1}")
+    rows = paths[episode][np.isfinite(paths[episode]).all(axis=1)]
+    title = f"{policy} rollout episode {episode} of trial {trial}"
+    return robot_episode(saved.task, saved.model, saved.latent_low, saved.latent_high, rows, saved.weights[trial],
+                         title, view, saved.demos)
+
+
 def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None, *, rerun: Path | None = None,
            trial: int = 0, episode: int | None = None, test: int | None = None, fps: int = 20, width: int = 960,
            max_frames: int = 400, view: str | None = None) -> str:
@@ -207,10 +240,23 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     if experiment not in REPLAYABLE:
         raise ValueError(f"{run_dir}: a run of {experiment}; replay draws runs of {', '.join(REPLAYABLE[:-1])} "
                          "and latentrl train")
-    if out is None and rerun is None:
-        raise ValueError("give --out FILE.gif|FILE.mp4, --rerun FILE.rrd or both")
     if (episode is None) == (test is None):
         raise ValueError("give one of --episode E (a recorded training episode) or --test T (a frozen test episode)")
+    check_request(out, rerun, fps, width, max_frames, view)
+    arrays = load_arrays(run_dir)
+    rows, what = episode_path(arrays, trial, episode, test, preset.episodes)
+    weights = arrays.get("latent_weights")
+    if weights is None:
+        raise ValueError(f"{run_dir}: the run kept no learnt weights to draw V from")
+    drawn = recorded(experiment, preset, run_dir, rows, np.asarray(weights)[trial], what, view)
+    return render(drawn, out, rerun, fps=fps, width=width, max_frames=max_frames)
+
+
+def check_request(out: Path | None, rerun: Path | None, fps: int, width: int, max_frames: int,
+                  view: str | None) -> None:
+    """ValueError naming the first flag of a replay request that cannot be drawn or written."""
+    if out is None and rerun is None:
+        raise ValueError("give --out FILE.gif|FILE.mp4, --rerun FILE.rrd or both")
     for flag, value, least in (("--fps", fps, 1), ("--width", width, 200), ("--max-frames", max_frames, 2)):
         if value < least:
             raise ValueError(f"{flag} must be at least {least}, got {value}")
@@ -222,12 +268,12 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
         from latentrl.rerun_log import check_rerun_output
 
         check_rerun_output(rerun)
-    arrays = load_arrays(run_dir)
-    rows, what = episode_path(arrays, trial, episode, test, preset.episodes)
-    weights = arrays.get("latent_weights")
-    if weights is None:
-        raise ValueError(f"{run_dir}: the run kept no learnt weights to draw V from")
-    drawn = recorded(experiment, preset, run_dir, rows, np.asarray(weights)[trial], what, view)
+
+
+def render(drawn: Recorded, out: Path | None, rerun: Path | None, *, fps: int = 20, width: int = 960,
+           max_frames: int = 400) -> str:
+    """Writes the episode `drawn` to the video `out` and/or the Rerun recording `rerun`; returns
+    what was written."""
     done = []
     if out is not None:
         frames = render_frames(drawn, size=(width, width // 2), max_frames=max_frames)
@@ -237,5 +283,5 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
         from latentrl.rerun_log import write_rerun
 
         write_rerun(drawn, rerun)
-        done.append(f"a Rerun recording of {len(rows)} steps in {rerun}")
-    return f"{what}: {' and '.join(done)}"
+        done.append(f"a Rerun recording of {len(drawn.latent)} steps in {rerun}")
+    return f"{drawn.title}: {' and '.join(done)}"
