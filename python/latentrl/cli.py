@@ -22,6 +22,7 @@ from latentrl import _native
 from latentrl.experiments.presets import field_docs, with_overrides
 from latentrl.experiments.registry import experiments, task_schema
 from latentrl.experiments.results import environment, read_json, write_json
+from latentrl.run_lock import run_lock
 from latentrl.task import by_path, changed_since
 from latentrl.train import POLICIES, format_rollout
 
@@ -346,7 +347,8 @@ def _report_of(out: Path, *, write: bool = False, as_json: bool = False) -> None
     findings = check_task(policy.task, policy.demos, policy.model, policy.latent_low, policy.latent_high)
     found = training_verdict(policy, findings=findings)
     if write:
-        write_json(out / "report.json", {**found.to_dict(), "environment": environment()})
+        with run_lock(out):
+            write_json(out / "report.json", {**found.to_dict(), "environment": environment()})
     print(json.dumps(found.to_dict(), indent=2) if as_json else found)
 
 
@@ -382,7 +384,6 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def _rollout(args: argparse.Namespace) -> int:
-    from latentrl.experiments.results import write_npz
     from latentrl.progress import progress_bar
     from latentrl.train import LatentPolicy
 
@@ -399,7 +400,16 @@ def _rollout(args: argparse.Namespace) -> int:
 
             results[kind] = policy.rollout(args.episodes, trial=args.trial, seed=args.seed, policy=kind,
                                            starts=args.starts, progress=report)
-    args.out.mkdir(parents=True, exist_ok=True)
+    with run_lock(args.out):
+        _write_rollout(args, path, policy, results)
+    for kind, r in results.items():
+        print(f"{kind:8s} {format_rollout(r['summary'])}")
+    return 0
+
+
+def _write_rollout(args: argparse.Namespace, path: Path, policy: Any, results: dict[str, dict[str, Any]]) -> None:
+    from latentrl.experiments.results import write_npz
+
     write_npz(args.out / "rollout.npz", {f"{kind}_{k}": r[k] for kind, r in results.items()
                                          for k in ("returns", "ends", "reached", "paths")})
     summary = {"policy": str(path.resolve()), "policy_from_out": os.path.relpath(path.resolve(), args.out.resolve()),
@@ -407,9 +417,6 @@ def _rollout(args: argparse.Namespace) -> int:
                "episodes": args.episodes, "seed": args.seed, "starts": args.starts,
                **{kind: r["summary"] for kind, r in results.items()}, "environment": environment()}
     write_json(args.out / "rollout.json", summary)
-    for kind, r in results.items():
-        print(f"{kind:8s} {format_rollout(r['summary'])}")
-    return 0
 
 
 def _policies(text: str) -> list[str]:

@@ -20,6 +20,7 @@ import numpy as np
 from latentrl.progress import progress_bar
 
 from latentrl._base import read_npz
+from latentrl.run_lock import run_lock
 from latentrl.task import changed_since, end_reasons, ran_with
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
@@ -145,9 +146,15 @@ def run_rl(
     `setup(preset, out_dir)` builds the learners (a continued run's in its saved model),
     `figures(preset, arrays, run_dir, figure_dir)` draws them at the end. `execute` runs the
     chunks (elsewhere, e.g. on a Ray cluster: `latentrl.experiments.sweep`); each finished
-    chunk is stored and saved here as it arrives."""
+    chunk is stored and saved here as it arrives. One writer at a time (`run_lock`)."""
     preset.validate()
-    out = Path(out_dir)
+    with run_lock(out_dir):
+        return _run_rl(preset, Path(out_dir), setup, figures, progress, chunk, execute)
+
+
+def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
+            figures: Callable[[Any, Mapping[str, np.ndarray], Path, Path], None], progress: bool,
+            chunk: int | None, execute: Execute) -> dict[str, Any]:
     meta_path, arrays_path = out / "results.json", out / "returns.npz"
     plan = describe(preset)
     arrays, meta = _previous(meta_path, arrays_path, plan)

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar, Protocol
 
 from latentrl.progress import progress_bar
+from latentrl.run_lock import run_lock
 
 from latentrl.experiments.presets import describe
 from latentrl.experiments.ray_backend import RayBackend
@@ -110,10 +111,13 @@ def run_sweep(
     that holds a sweep is refused unless `resume`, which continues the same sweep (finished
     trials are kept, whichever backend ran them; a cell counts as done once its figures are
     drawn). Failed cells raise a SweepError after the others finished; Ctrl-C (a
-    KeyboardInterrupt) keeps finished trials."""
-
+    KeyboardInterrupt) keeps finished trials. One writer at a time (`run_lock`)."""
     runner = _backend(backend)
-    out = Path(out_dir)
+    with run_lock(out_dir):
+        return _run_sweep(sweep, Path(out_dir), runner, resume, progress)
+
+
+def _run_sweep(sweep: Sweep, out: Path, runner: Backend, resume: bool, progress: bool) -> dict[str, Any]:
     cells = sweep.expand()
     state = _open(out, sweep, cells, resume)
     kind = rl_experiments()[sweep.experiment]
