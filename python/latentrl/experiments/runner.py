@@ -319,7 +319,9 @@ def _check_saved_run(out: Path, plan: dict[str, Any], arrays: Mapping[str, np.nd
 def _check_continued(meta: Mapping[str, Any], built: Setup, arrays: Mapping[str, np.ndarray], out: Path) -> None:
     """A continued run's trials ran with the task the setup builds and its per-episode arrays
     have the preset's shapes (its model fit is checked where the setup reads it back:
-    `latent_runs.run_fit`)."""
+    `latent_runs.run_fit`) and with the inputs it recorded (`check_inputs`: first, since a
+    changed input can change settings derived from it)."""
+    check_inputs(meta.get("setup", {}).get("inputs") or {}, built.info.get("inputs") or {}, out)
     recorded = meta.get("setup", {}).get("task")
     keys = sorted(changed_since(recorded, as_saved(built.info.get("task")) or {})) if recorded is not None else []
     if keys:
@@ -332,6 +334,15 @@ def _check_continued(meta: Mapping[str, Any], built: Setup, arrays: Mapping[str,
             if key in arrays and arrays[key].shape != want:
                 raise ValueError(f"{out}/returns.npz: {key} has shape {arrays[key].shape}, the preset asks for "
                                  f"{want} (trials, episodes); it belongs to another run")
+
+
+def check_inputs(recorded: Mapping[str, str], now: Mapping[str, str], out: Path) -> None:
+    """ValueError naming the first input (URDF, demos, model) whose SHA-256 the run recorded
+    and that now differs: a run is continued only with what it was made from."""
+    for name, digest in recorded.items():
+        if name in now and now[name] != digest:
+            raise ValueError(f"{out}: its {name} changed since the run (sha256 {digest[:12]}… ≠ {now[name][:12]}…); "
+                             "resume refuses to mix the two: restore it, or start a new run with --out")
 
 
 def load_arrays(out_dir: Path | str) -> dict[str, np.ndarray]:

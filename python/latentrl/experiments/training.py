@@ -91,7 +91,23 @@ def setup(run: TrainRun, out: Path | None = None) -> Setup:
     task, demos, model, settings = prepared(run, out)
     built = latent_setup(run, task, model, latent_box(model.Z_, run.latent_margin), demos)
     built.info["derived"] = [d.to_dict() for d in settings]
+    built.info["inputs"] = input_digests(task, demos, model)
     return built
+
+
+def input_digests(task: Task, demos: np.ndarray, model: GPLVM) -> dict[str, str]:
+    """SHA-256 of what a run is made from beyond its task keys: the URDF's bytes, the demo
+    postures as the learner gets them (joint order, float64) and the GPLVM's arrays; a resume
+    compares them (`runner.check_inputs`)."""
+    def sha(data: bytes) -> str:
+        return hashlib.sha256(data).hexdigest()
+
+    arrays = model._arrays()
+    return {
+        "urdf": sha(task.urdf_path.read_bytes()),
+        "demos": sha(np.ascontiguousarray(demos, dtype=np.float64).tobytes()),
+        "model": sha(b"".join(k.encode() + np.ascontiguousarray(arrays[k]).tobytes() for k in sorted(arrays))),
+    }
 
 
 def save_policy(run: TrainRun, out: Path) -> LatentPolicy:
