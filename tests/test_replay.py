@@ -173,5 +173,12 @@ def test_a_lifting_arm_is_seen_from_the_side_and_its_height_changes_the_picture(
     assert abs(heights[1] - heights[0]) > 0.05
     assert not np.array_equal(images[0], images[1])
     assert view_axes(task, np.zeros((1, 3)), np.zeros((1, 3)), "top") == VIEWS["top"] == (0, 1)
+    # The arm's links are collision meshes: each is drawn as the outline of the hull it collides with.
+    from latentrl.render import shape_outline
+
+    pose_of = dict(zip(task.link_names, np.asarray(plant.link_poses())))
+    meshes = [shape for shape in task._native.collision_shapes() if shape["kind"] == "mesh"]
+    assert meshes and all(len(shape["points"]) == shape["hull"]["vertices"] for shape in meshes)
+    assert all(shape_outline(pose_of[shape["link"]], shape, (0, 2)) is not None for shape in meshes)
     with pytest.raises(ValueError, match="view must be one of top, side, front"):
         draw_task(task, plant, view="3d")

@@ -161,9 +161,9 @@ _BALL = np.vstack([_RING, _RING[:, [0, 2, 1]], _RING[:, [2, 0, 1]]])
 
 
 def shape_outline(link_pose: NDArray[np.float64], shape: Mapping[str, Any], view: tuple[int, int]) -> NDArray[np.float64] | None:
-    """The outline (K, 2) of a primitive collision shape of a link at `link_pose`, projected on
-    the `view` axes (the convex hull of its corners, or of points on its end circles); None for
-    a mesh (drawn by its link's stick) or a shape seen edge-on."""
+    """The outline (K, 2) of a collision shape of a link at `link_pose`, projected on the `view`
+    axes (the convex hull of its corners, of points on its end circles, or of a mesh's hull
+    vertices); None for a shape seen edge-on (or a mesh without its hull)."""
     from scipy.spatial import ConvexHull, QhullError
 
     size = np.asarray(shape["size"], dtype=np.float64)
@@ -175,6 +175,8 @@ def shape_outline(link_pose: NDArray[np.float64], shape: Mapping[str, Any], view
         radius, length = size
         ends = _BALL if shape["kind"] == "capsule" else _RING
         local = np.vstack([ends * radius + [0, 0, z] for z in (-length / 2, length / 2)])
+    elif shape["kind"] == "mesh" and len(shape.get("points") or ()) >= 3:
+        local = np.asarray(shape["points"], dtype=np.float64)  # the hull the physics collides with
     else:
         return None
     centre, rotation = shape_world_pose(link_pose, shape)

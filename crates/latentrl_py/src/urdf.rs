@@ -34,6 +34,7 @@ pub fn shape_dict<'py>(py: Python<'py>, s: &ShapeInfo, links: &[&str]) -> PyResu
         None => None,
     };
     d.set_item("hull", hull)?;
+    d.set_item("points", &s.points)?;
     Ok(d)
 }
 

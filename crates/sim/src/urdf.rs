@@ -145,6 +145,9 @@ pub struct ShapeInfo {
     /// A collision mesh's triangles in the file and vertices of its hull, and whether the
     /// hull came from the cache; `None` for primitives and visual shapes.
     pub hull: Option<(usize, usize, bool)>,
+    /// A collision mesh's hull vertices in the shape's frame (scaled), to draw it; empty for
+    /// primitives and visual shapes.
+    pub points: Vec<[f64; 3]>,
 }
 
 /// A parsed and checked URDF robot.
@@ -467,6 +470,7 @@ impl UrdfModel {
                 if let Some(h) = hull {
                     info.file = Some(h.path.display().to_string());
                     info.hull = Some((h.source_triangles, h.points.len(), h.cached));
+                    info.points = h.points.iter().map(|p| p.map(f64::from)).collect();
                 }
                 out.push(info);
             }
@@ -508,6 +512,7 @@ impl UrdfModel {
             origin: crate::pose::origin_pose(origin),
             file,
             hull: None,
+            points: Vec::new(),
         }
     }
 
