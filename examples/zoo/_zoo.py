@@ -8,10 +8,12 @@ imports this module) and its task file.
 
 from __future__ import annotations
 
+import argparse
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -236,3 +238,15 @@ def keep_admissible(kin: Kin, Q: NDArray[np.float64], n_max: int) -> NDArray[np.
     counts = {int(c): int((codes == c).sum()) for c in np.unique(codes)}
     print(f"classify: {counts} (0 = admissible) of {len(Q)} IK solutions")
     return Q[codes == 0][:n_max]
+
+
+def generator(here: Path) -> tuple[np.random.Generator, Any, Kin]:
+    """A demo generator's start: its `--seed` flag (default 0) as a NumPy generator, the task file
+    beside it (`here / "task.toml"`) and that task's kinematics."""
+    from latentrl import Task
+
+    parser = argparse.ArgumentParser(description="writes demos.csv beside this script")
+    parser.add_argument("--seed", type=int, default=0)
+    rng = np.random.default_rng(parser.parse_args().seed)
+    task = Task.load(here / "task.toml")
+    return rng, task, Kin(task)

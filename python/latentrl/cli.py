@@ -165,26 +165,12 @@ def build_parser() -> argparse.ArgumentParser:
         if exp.rl:
             _add_task_flags(cmd, task_schema(name), exp.rl.task(exp.preset()))
     train = sub.add_parser("train", help="train a latent policy on a task file from demonstrations; writes DIR/policy.npz")
-    train.add_argument("task", type=Path, help="the task file (TOML; docs/tasks.md)")
-    train.add_argument("--demos", type=Path, required=True, help="demonstrated postures: .csv (header of joint names), .npz or .json")
     train.add_argument("--out", type=Path, required=True, help="results directory (results.json, returns.npz, policy.npz)")
-    train.add_argument("--model", type=Path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2)")
-    train.add_argument("--quick", action="store_true", help="a short run (TrainPreset.quick)")
     train.add_argument("--resume", action="store_true", help="continue the interrupted run in --out (same arguments)")
-    train.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
-    from latentrl.experiments.training import TrainRun
-
-    _add_preset_flags(train, TrainRun, exclude=("task_file", "demos", "model"))
-    _add_task_flags(train, _native.task_schema())  # defaults: the task file's, else these
+    _add_training_flags(train, "a short run (TrainPreset.quick)")
     check = sub.add_parser("check", help="before training: will the task learn from these demos? (exit 3 if not)")
-    check.add_argument("task", type=Path, help="the task file (TOML; docs/tasks.md)")
-    check.add_argument("--demos", type=Path, required=True, help="demonstrated postures: .csv (header of joint names), .npz or .json")
-    check.add_argument("--model", type=Path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2)")
-    check.add_argument("--quick", action="store_true", help="cost the short run (TrainPreset.quick) instead of the default")
     check.add_argument("--json", action="store_true", help="print the findings as JSON instead of a table")
-    check.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
-    _add_preset_flags(check, TrainRun, exclude=("task_file", "demos", "model"))
-    _add_task_flags(check, _native.task_schema())
+    _add_training_flags(check, "cost the short run (TrainPreset.quick) instead of the default")
     report = sub.add_parser("report", help="the verdict on a trained policy: learnt, stopped improving below the "
                                            "target, or never reached it, with what to try next")
     report.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz)")
@@ -249,6 +235,20 @@ def build_parser() -> argparse.ArgumentParser:
     urdf.add_argument("--balance-inertia", action="store_true",
                       help="repair inertias the physics refuses (triangle inequality, all zero), naming each link")
     return parser
+
+
+def _add_training_flags(cmd: argparse.ArgumentParser, quick: str) -> None:
+    """What `train` and `check` share: the task file, the demos, a saved model, --quick, the
+    preset fields and every task key as flags (defaults: the task file's, else the schema's)."""
+    from latentrl.experiments.training import TrainRun
+
+    cmd.add_argument("task", type=Path, help="the task file (TOML; docs/tasks.md)")
+    cmd.add_argument("--demos", type=Path, required=True, help="demonstrated postures: .csv (header of joint names), .npz or .json")
+    cmd.add_argument("--model", type=Path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2)")
+    cmd.add_argument("--quick", action="store_true", help=quick)
+    cmd.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
+    _add_preset_flags(cmd, TrainRun, exclude=("task_file", "demos", "model"))
+    _add_task_flags(cmd, _native.task_schema())
 
 
 def _dimension(text: str) -> int | str:

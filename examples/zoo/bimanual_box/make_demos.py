@@ -7,7 +7,6 @@ plant.classify) are dropped, and every kept posture is checked on the plant's ki
     python examples/zoo/bimanual_box/make_demos.py [--seed 0]
 """
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -16,9 +15,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import Kin, keep_admissible  # noqa: E402
+from _zoo import generator, keep_admissible  # noqa: E402
 
-from latentrl import Demonstrations, Task, save_demos  # noqa: E402
+from latentrl import Demonstrations, save_demos  # noqa: E402
 
 L1, L2, L3 = 0.30, 0.25, 0.08
 SHOULDER = {"l": -0.12, "r": 0.12}
@@ -37,12 +36,7 @@ def arm(side: str, hx: float, hy: float) -> list[float]:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    rng = np.random.default_rng(args.seed)
-    task = Task.load(HERE / "task.toml")
-    kin = Kin(task)
+    rng, task, kin = generator(HERE)
     Q, centres = [], []
     for cy in np.linspace(0.15, 0.45, 9):
         for cx in np.linspace(-0.15, 0.15, 13):

@@ -9,7 +9,6 @@ left sole, the task's target.
     python examples/zoo/biped_pick/make_demos.py [--seed 0]
 """
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -18,9 +17,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import Kin, keep_admissible  # noqa: E402
+from _zoo import generator, keep_admissible  # noqa: E402
 
-from latentrl import Demonstrations, Task, save_demos  # noqa: E402
+from latentrl import Demonstrations, save_demos  # noqa: E402
 
 
 def posture(names: tuple[str, ...], a: float, b: float) -> np.ndarray:
@@ -29,12 +28,7 @@ def posture(names: tuple[str, ...], a: float, b: float) -> np.ndarray:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    rng = np.random.default_rng(args.seed)
-    task = Task.load(HERE / "task.toml")
-    kin = Kin(task)
+    rng, task, kin = generator(HERE)
     ab = np.column_stack([rng.uniform(0.0, 1.0, 110), rng.uniform(0.0, 1.6, 110)])
     ab[0] = [0.0, 0.0]
     Q = np.array([posture(task.joint_names, a, b) for a, b in ab])

@@ -9,7 +9,6 @@ arm's points pushed out of the table and shelf; postures a rule refuses at rest
     python examples/zoo/iiwa_tray/make_demos.py [--seed 0]
 """
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -18,9 +17,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import Kin, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
+from _zoo import generator, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
 
-from latentrl import Demonstrations, Task, save_demos  # noqa: E402
+from latentrl import Demonstrations, save_demos  # noqa: E402
 
 BOXES = [([0.35, -0.75, 0.0], [0.85, -0.15, 0.25]), ([0.35, 0.15, 0.60], [0.85, 0.75, 0.63])]
 CHAIN = ["iiwa_link_2", "iiwa_link_4", "iiwa_link_6", "tray"]
@@ -28,12 +27,7 @@ Q_NOM = np.array([0.0, 0.55, 0.0, -0.97, 0.0, 1.6, 0.0])
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    rng = np.random.default_rng(args.seed)
-    task = Task.load(HERE / "task.toml")
-    kin = Kin(task)
+    rng, task, kin = generator(HERE)
     n = 140
     phi, z = rng.uniform(-1.0, 1.0, n), rng.uniform(0.35, 0.78, n)
     Q = []

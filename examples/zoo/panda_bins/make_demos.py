@@ -9,7 +9,6 @@ branch), with the arm's points pushed out of the divider; postures a rule refuse
     python examples/zoo/panda_bins/make_demos.py [--seed 0]
 """
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -18,9 +17,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import Kin, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
+from _zoo import generator, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
 
-from latentrl import Demonstrations, Task, save_demos  # noqa: E402
+from latentrl import Demonstrations, save_demos  # noqa: E402
 
 DIVIDER = ([0.30, -0.015, 0.0], [0.70, 0.015, 0.22])
 CHAIN = ["panda_link3", "panda_link5", "panda_link7", "panda_hand", "tcp"]
@@ -28,12 +27,7 @@ Q_NOM = np.array([0.0, 0.3, 0.0, -2.1, 0.0, 2.4, 0.785])
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    rng = np.random.default_rng(args.seed)
-    task = Task.load(HERE / "task.toml")
-    kin = Kin(task)
+    rng, task, kin = generator(HERE)
     n = 140
     goals = np.column_stack([np.full(n, 0.5), rng.uniform(-0.42, 0.42, n), rng.uniform(0.05, 0.55, n)])
     goals[0] = [0.5, -0.3, 0.1]

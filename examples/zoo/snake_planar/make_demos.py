@@ -6,7 +6,6 @@ own kinematics from one coiled nominal posture, with the links' points pushed ou
     python examples/zoo/snake_planar/make_demos.py [--seed 0]
 """
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -15,9 +14,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import Kin, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
+from _zoo import generator, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
 
-from latentrl import Demonstrations, Task, save_demos  # noqa: E402
+from latentrl import Demonstrations, save_demos  # noqa: E402
 
 WALL = ([0.06, -0.05, -0.05], [0.08, 0.10, 0.05])
 CHAIN = ["seg1", "seg2", "seg3", "seg4", "seg5", "seg6", "tip"]
@@ -25,12 +24,7 @@ Q_NOM = np.array([1.2, -0.4, -0.4, -0.4, -0.4, -0.4])
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    rng = np.random.default_rng(args.seed)
-    task = Task.load(HERE / "task.toml")
-    kin = Kin(task)
+    rng, task, kin = generator(HERE)
     r = np.sqrt(rng.uniform(0.06 ** 2, 0.27 ** 2, 400))
     a = rng.uniform(0.02, np.pi - 0.02, 400)
     goals = np.column_stack([r * np.cos(a), np.maximum(r * np.sin(a), 0.005)])

@@ -8,7 +8,6 @@ rest (plant.classify) are dropped.
     python examples/zoo/ur_reach/make_demos.py [--seed 0]
 """
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -17,9 +16,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import Kin, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
+from _zoo import generator, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
 
-from latentrl import Demonstrations, Task, save_demos  # noqa: E402
+from latentrl import Demonstrations, save_demos  # noqa: E402
 
 WALL = ([0.30, -0.30, 0.0], [0.36, 0.30, 0.25])
 CHAIN = ["upper_arm_link", "forearm_link", "wrist_1_link", "wrist_3_link", "tool0"]
@@ -27,12 +26,7 @@ Q_NOM = np.array([0.0, -1.12, 1.78, -2.23, -1.57, 0.0])
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--seed", type=int, default=0)
-    args = ap.parse_args()
-    rng = np.random.default_rng(args.seed)
-    task = Task.load(HERE / "task.toml")
-    kin = Kin(task)
+    rng, task, kin = generator(HERE)
     n = 140
     goals = np.column_stack([rng.uniform(0.12, 0.75, n), np.zeros(n), rng.uniform(0.06, 0.65, n)])
     Q = []
