@@ -35,9 +35,22 @@ def test_a_task_that_learns_is_ok(glass):
     task, demos, model = glass
     report = check(task, demos, model)
     assert report.verdict == "ok", str(report)
-    assert list(verdicts(report)) == ["demos", "fit", "latent box", "target", "paths", "servos", "cost"]
+    assert list(verdicts(report)) == ["demos", "fit", "latent box", "target", "paths", "encoder", "servos", "cost"]
     paths = next(f for f in report.findings if f.name == "paths")
     assert paths.values["with_path"] > 0.9 and paths.values["moves_p95"] < 200
+    assert paths.values["with_path"] <= paths.values["with_path_at_rest"]  # physics can only block moves
+
+
+def test_an_encoder_whose_round_trip_jumps_is_named():
+    """The zoo's Panda-style arm: a decoded posture encodes ~80 learner steps away with the GP
+    encoder (its quick training reached the bin in 0 % of rollouts; with the back-constrained
+    encoder the soft-max reached it in 75 %): the encoder finding warns and names the fix."""
+    zoo = ROOT / "examples" / "zoo" / "panda_bins"
+    task = Task.load(zoo / "task.toml")
+    loaded = load_demos(zoo / "demos.csv")
+    demos = task.demo_postures(loaded.joint_names, loaded.postures, "demos")
+    found = next(f for f in check(task, demos).findings if f.name == "encoder")
+    assert found.verdict == "warning" and found.values["median_steps"] > 10 and "back_constrained" in found.fix
 
 
 def test_a_target_outside_the_decodable_region_will_not_learn(glass):

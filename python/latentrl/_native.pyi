@@ -415,6 +415,7 @@ def latent_survey(
     latent_high: ArrayLike,
     demos: NDArray[np.float64] | None = None,
     max_points: int = 20000,
+    physics: bool = False,
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
     """The task's latent space at rest on a grid at its learner step: per point the rule broken,

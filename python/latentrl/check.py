@@ -17,8 +17,11 @@ The findings, in order (docs/tasks.md, "Before training: latentrl check"):
 - **target**: the closest any admissible grid point brings the effectors to the target, against
   `target.reach_radius`, and how wide the region within it is against the learner's step;
 - **paths**: the share of admissible points from which the learner's own moves reach that
-  region through admissible points (judged at rest: necessary, not sufficient), and the moves it
-  takes against `episode.max_steps`;
+  region without breaking a rule, each move run from rest through the task's physics (a move
+  that tips a held object or swings through an obstacle on the way is blocked; the share judged
+  at rest beside it), and the moves it takes against `episode.max_steps`;
+- **encoder**: how many learner steps a decoded posture encodes away from where it was decoded
+  (the learner's state after a move is the encoded reached posture);
 - **servos**: how far the effectors are from each demo's posture after the servos held it
   0.75 s, against `physics.tolerance`;
 - **cost**: the measured time of an RL step, an episode and the run's budget on this machine.
@@ -62,6 +65,15 @@ HOLD_S = 0.75
 
 MOVE_S = 0.25
 """Seconds the servos take from one demo posture to the next."""
+
+ROUND_TRIP = 1.0
+"""Learner steps a decoded posture may encode away from its latent point (the median over the
+grid) before the encoder finding warns: on the zoo the robots that learnt had 0.00–0.18, those
+that did not 11–79 (docs/tasks.md)."""
+
+MAX_POINTS = 4096
+"""Grid points the check surveys at most: each admissible one is put at rest and every learner
+move from it run through the physics, ≈ 30 s of CPU for a humanoid at 2 ms per RL step."""
 
 
 @dataclass(frozen=True)
@@ -108,8 +120,10 @@ class CheckReport:
 
 def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | None = None) -> CheckReport:
     """Will `task` learn from `demos` (N, D postures in its joint order)? The findings of the
-    module docs; `model`: a fitted GPLVM (default: one fitted here, d = 2, seed 0, as `train`
-    fits); `latent_margin`: the box's margin (default: `TrainPreset`'s)."""
+    module docs, with the settings `train` would derive where the task is silent; `model`: a
+    fitted GPLVM (default: one fitted here, d = 2, seed 0, as `train` fits); `latent_margin`: the
+    box's margin (default: `TrainPreset`'s)."""
+    from latentrl.derive import derive
     from latentrl.experiments.presets import latent_box
     from latentrl.gplvm import GPLVM
     from latentrl.train import TrainPreset
@@ -122,12 +136,17 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     if model is None:
         model = GPLVM(n_components=2, random_state=0, max_iter=preset.gplvm_max_iter).fit(postures)
     low, high = latent_box(model.Z_, preset.latent_margin if latent_margin is None else latent_margin)
-    return check_task(task, postures, model, low, high, budget=(preset.trials, preset.episodes))
+    if demo_finding(task, postures).verdict == "will not learn":  # nothing to derive from: say why
+        derived = {}
+    else:
+        derived = {d.key: d.value for d in derive(task, model, low, high, postures, set(task.given))}
+    return check_task(task.replace(derived, origin=task.origin), postures, model, low, high,
+                      budget=(preset.trials, preset.episodes))
 
 
 def check_task(task: Task, demos: NDArray[np.float64], model: Any, low: NDArray[np.float64],
                high: NDArray[np.float64], *, budget: tuple[int, int] = (4, 2000), threads: int = 1,
-               max_points: int = 20_000, progress: Any = None) -> CheckReport:
+               max_points: int = MAX_POINTS, progress: Any = None) -> CheckReport:
     """The findings of the module docs for `task` with `demos` (N, D) in its joint order, the
     fitted GPLVM `model` and the latent box [`low`, `high`]; `budget` (trials, episodes) is the
     training run costed, on `threads` threads."""
@@ -135,8 +154,9 @@ def check_task(task: Task, demos: NDArray[np.float64], model: Any, low: NDArray[
     if findings[0].verdict == "will not learn":  # the rest would measure a space the task refuses
         return CheckReport(task.name, tuple(findings))
     survey = _native.latent_survey(task._native, decoder=model.decoder_, latent_low=low, latent_high=high,
-                                   demos=demos, max_points=max_points, progress=progress)
+                                   demos=demos, max_points=max_points, physics=True, progress=progress)
     findings += survey_findings(task, survey)
+    findings.append(encoder_finding(model, survey))
     findings.append(servo_finding(task, demos))
     findings.append(cost_finding(task, demos, budget, threads))
     return CheckReport(task.name, tuple(findings))
@@ -218,23 +238,53 @@ def survey_findings(task: Task, survey: dict[str, Any]) -> list[Finding]:
         + ("; the region is about one learner step wide, so a step can jump over it" if isolated else ""),
         f"learner.step = {config['learner']['step'] / 2:g} (half) lands more often inside it" if isolated else None,
         {"reached_points": n_reached, "closest_m": best})
-    with_path = moves[admissible] >= 0
-    path_share = float(with_path.mean())
-    needed = int(np.percentile(moves[moves >= 0], 95))
+    physics = survey["moves_in_physics"]
+    path_share = float((moves[admissible] >= 0).mean())
+    moved_share = float((physics[admissible] >= 0).mean())
+    blocked = float(np.asarray(survey["blocked"]).reshape(len(codes), -1)[admissible].mean())
+    reachable = physics[physics >= 0]
+    needed = int(np.percentile(reachable if len(reachable) else moves[moves >= 0], 95))
     max_steps = config["episode"]["max_steps"]
     short = max_steps < needed
-    verdict = "warning" if short or path_share < PATH_SHARE else "ok"
+    verdict = "warning" if short or moved_share < PATH_SHARE else "ok"
     fix = []
     if short:
         fix.append(f"episode.max_steps = {2 * needed}")
-    if path_share < PATH_SHARE:
+    if moved_share < PATH_SHARE <= path_share:
+        fix.append("moves break rules on the way between postures that keep them: a smaller learner.step, stiffer "
+                   "servos, or demos closer together (neighbouring demos far apart in a joint swing in transit)")
+    elif moved_share < PATH_SHARE:
         fix.append("demos that connect the starts with the target, or episode.start that starts nearer it")
     paths = Finding(
         "paths", verdict,
-        f"from {path_share:.0%} of the admissible points the learner's moves reach the target through admissible "
-        f"postures (at rest); 95 % of those need ≤ {needed} moves, episode.max_steps = {max_steps}",
-        "; ".join(fix) or None, {"with_path": path_share, "moves_p95": needed, "max_steps": max_steps})
+        f"from {moved_share:.0%} of the admissible points the learner's moves reach the target without breaking a "
+        f"rule, each move run from rest through the physics ({path_share:.0%} judged at rest; {blocked:.0%} of "
+        f"the moves break a rule on the way); 95 % of those need ≤ {needed} moves, episode.max_steps = {max_steps}",
+        "; ".join(fix) or None,
+        {"with_path": moved_share, "with_path_at_rest": path_share, "blocked_moves": blocked, "moves_p95": needed,
+         "max_steps": max_steps})
     return [box, target, paths]
+
+
+def encoder_finding(model: Any, survey: dict[str, Any]) -> Finding:
+    """How far the encoder maps a decoded posture back from where it was decoded, in learner
+    steps (the median over the admissible grid points): the learner's state after a move is the
+    encoded reached posture, so a round trip of many steps makes its state jump about."""
+    admissible = survey["codes"] == 0
+    if not admissible.any():
+        return Finding("encoder", "ok", "no admissible point to measure")
+    points = survey["points"][admissible]
+    back = model.transform(model.inverse_transform(points))
+    step = float(np.min(survey["spacing"]) / survey["stride"])
+    steps = np.linalg.norm(back - points, axis=1) / step
+    median = float(np.median(steps))
+    values = {"median_steps": median, "p90_steps": float(np.percentile(steps, 90))}
+    message = (f"a decoded posture encodes {median:.2g} learner steps from where it was decoded (median; 90 %: "
+               f"{values['p90_steps']:.2g})")
+    if median <= ROUND_TRIP:
+        return Finding("encoder", "ok", message, None, values)
+    return Finding("encoder", "warning", message + ": the learner's state jumps after its moves",
+                   "--encoder back_constrained (encodes the demos exactly), or a converged fit", values)
 
 
 def servo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:

@@ -468,9 +468,10 @@ pub fn run_task_trials<'py>(
 /// latent_high] at the task's learner step (coarsened to at most `max_points` points), each
 /// point decoded by `decoder` and classified by the task's plant. Returns {shape, stride,
 /// spacing, points (M, d), codes (M,), reward (M,), distance (M,), reached (M,), effectors
-/// (M, 3E), moves (M,): fewest learner moves to the target region, -1 for none}.
+/// (M, 3E), moves (M,): fewest learner moves to the target region, -1 for none; with `physics`
+/// each move also run from rest through the physics: blocked (M·A,) and moves_in_physics (M,)}.
 #[pyfunction]
-#[pyo3(signature = (task, *, decoder, latent_low, latent_high, demos = None, max_points = 20_000, progress = None))]
+#[pyo3(signature = (task, *, decoder, latent_low, latent_high, demos = None, max_points = 20_000, physics = false, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn latent_survey<'py>(
     py: Python<'py>,
@@ -480,6 +481,7 @@ pub fn latent_survey<'py>(
     latent_high: &Bound<'py, PyAny>,
     demos: Option<PyReadonlyArray2<'py, f64>>,
     max_points: usize,
+    physics: bool,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
@@ -496,7 +498,7 @@ pub fn latent_survey<'py>(
         TaskPlant::new(Arc::clone(&task), demos.as_deref()).map_err(sim_to_py)?;
         let at = LearnerGrid::new(&task, &maps.low, &maps.high, max_points).map_err(sim_to_py)?;
         let s = run_with_polling(py, at.grid.len(), progress.as_ref(), |cancel, done| {
-            survey(&task, demos.as_deref(), maps.decoder, &at, cancel, done).map_err(sim_to_py)
+            survey(&task, demos.as_deref(), maps.decoder, &at, physics, cancel, done).map_err(sim_to_py)
         })?;
         let out = PyDict::new(py);
         let (m, d) = (s.grid.len(), maps.low.len());
@@ -514,8 +516,10 @@ pub fn latent_survey<'py>(
         out.set_item("reached", PyArray1::from_vec(py, s.reached))?;
         let e = s.effectors.len() / m.max(1);
         out.set_item("effectors", to_points(py, DMatrix::from_vec(e, m, s.effectors))?)?;
-        let moves: Vec<i64> = s.moves_to_target.iter().map(|x| x.map_or(-1, |v| v as i64)).collect();
-        out.set_item("moves", PyArray1::from_vec(py, moves))?;
+        let moves = |m: &[Option<usize>]| m.iter().map(|x| x.map_or(-1, |v| v as i64)).collect::<Vec<i64>>();
+        out.set_item("moves", PyArray1::from_vec(py, moves(&s.moves_to_target)))?;
+        out.set_item("moves_in_physics", PyArray1::from_vec(py, moves(&s.moves_in_physics)))?;
+        out.set_item("blocked", PyArray1::from_vec(py, s.blocked))?;
         Ok(out)
     })
 }

@@ -5,9 +5,12 @@
 //! through admissible points.
 //!
 //! A move is judged at rest: it is allowed when the point it lands on is an admissible posture.
-//! What happens on the way (servo lag, a swing through an obstacle between two clear postures)
-//! is the physics' and is not simulated, so a path here is necessary for learning, not
-//! sufficient; a start with no path here has none in training either, up to the grid.
+//! With `physics`, each move from each admissible point is also run through the task's physics
+//! from rest there (the learner's targets along it, one RL step each) and is blocked when a rule
+//! breaks on the way (a swing through an obstacle between two clear postures, a held object
+//! tipped in transit). A path either way is necessary for learning, not sufficient (the learner
+//! moves from where it is, not from rest); a start with no path has none in training either, up
+//! to the grid.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -126,6 +129,11 @@ pub struct Survey {
     /// Per point: the fewest learner moves (grid moves × stride) to a reached point through
     /// admissible points; `None` if there is no such path (or the point is not admissible).
     pub moves_to_target: Vec<Option<usize>>,
+    /// With `physics`: per point and move (point-major), whether the move broke a rule on the
+    /// way, run from rest; empty without.
+    pub blocked: Vec<bool>,
+    /// With `physics`: [`Survey::moves_to_target`] through the moves that broke no rule.
+    pub moves_in_physics: Vec<Option<usize>>,
 }
 
 /// The grid of a [`survey`] and the learner's moves on it.
@@ -164,14 +172,15 @@ impl LearnerGrid {
     }
 }
 
-/// Surveys `task`'s latent space of `decoder` on `at` (its grid and the learner's moves);
-/// `demos` as for [`TaskPlant::new`]. Points are classified in parallel, `done` counts them and
-/// `cancel` stops the survey (an error).
+/// Surveys `task`'s latent space of `decoder` on `at` (its grid and the learner's moves), each
+/// move also through the physics with `physics`; `demos` as for [`TaskPlant::new`]. Points are
+/// classified in parallel, `done` counts them and `cancel` stops the survey (an error).
 pub fn survey(
     task: &Arc<Task>,
     demos: Option<&[Vec<f64>]>,
     decoder: &GpMap,
     at: &LearnerGrid,
+    physics: bool,
     cancel: &AtomicBool,
     done: &AtomicUsize,
 ) -> Result<Survey> {
@@ -213,6 +222,12 @@ pub fn survey(
                     part.distance.push(plant.rms_distance());
                     part.reached.push(code == 0 && plant.reached_target());
                     part.effectors.extend_from_slice(&plant.effectors()[..e]);
+                    if physics {
+                        for offset in &at.moves {
+                            let blocked = code != 0 || breaks_on_the_way(plant, decoder, grid, i, offset, &mut scratch);
+                            part.blocked.push(blocked);
+                        }
+                    }
                 }
                 done.fetch_add(end - start, Ordering::Relaxed);
                 Ok(part)
@@ -226,10 +241,18 @@ pub fn survey(
         all.distance.extend(p.distance);
         all.reached.extend(p.reached);
         all.effectors.extend(p.effectors);
+        all.blocked.extend(p.blocked);
     }
-    let moves_to_target = fewest_moves(grid, &all.codes, &all.reached, &at.moves);
+    let moves_to_target = fewest_moves(grid, &all.codes, &all.reached, &at.moves, &[]);
+    let moves_in_physics = if physics {
+        fewest_moves(grid, &all.codes, &all.reached, &at.moves, &all.blocked)
+    } else {
+        Vec::new()
+    };
     Ok(Survey {
         moves_to_target,
+        moves_in_physics,
+        blocked: all.blocked,
         codes: all.codes,
         reward: all.reward,
         distance: all.distance,
@@ -239,9 +262,50 @@ pub fn survey(
     })
 }
 
+/// Whether the move `offset` from point `index`, run from rest there through the plant (one RL
+/// step per learner step, towards the decoded points along it), breaks a rule on the way.
+fn breaks_on_the_way(
+    plant: &mut TaskPlant,
+    decoder: &GpMap,
+    grid: &LatentGrid,
+    index: usize,
+    offset: &[i64],
+    scratch: &mut latent_core::gp::PredictScratch,
+) -> bool {
+    let Some(next) = grid.neighbour(index, offset) else {
+        return true; // out of the box: the learner's box exit
+    };
+    let d = offset.len();
+    let (mut from, mut to, mut z) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
+    grid.point(index, &mut from);
+    grid.point(next, &mut to);
+    let mut q = vec![0.0; decoder.output_dim()];
+    decoder.mean_into(&from, &mut q, scratch);
+    if plant.reset(&q).is_some() {
+        return true;
+    }
+    let mut reached = vec![0.0; q.len()];
+    let steps = grid.stride();
+    (1..=steps).any(|k| {
+        let t = k as f64 / steps as f64;
+        for ((z, a), b) in z.iter_mut().zip(&from).zip(&to) {
+            *z = a + t * (b - a);
+        }
+        decoder.mean_into(&z, &mut q, scratch);
+        plant.step(&q, &mut reached).end.is_some_and(|e| e.is_terminal())
+    })
+}
+
 /// Breadth-first from the reached points backwards along every move: the fewest grid moves
-/// (× the grid's stride) from each admissible point to a reached one.
-fn fewest_moves(grid: &LatentGrid, codes: &[u8], reached: &[bool], offsets: &[Vec<i64>]) -> Vec<Option<usize>> {
+/// (× the grid's stride) from each admissible point to a reached one; `blocked` (point-major,
+/// one per move; empty: none) leaves moves out.
+fn fewest_moves(
+    grid: &LatentGrid,
+    codes: &[u8],
+    reached: &[bool],
+    offsets: &[Vec<i64>],
+    blocked: &[bool],
+) -> Vec<Option<usize>> {
     let mut out = vec![None; grid.len()];
     let mut queue = VecDeque::new();
     for (i, _) in reached.iter().enumerate().filter(|(_, r)| **r) {
@@ -249,12 +313,14 @@ fn fewest_moves(grid: &LatentGrid, codes: &[u8], reached: &[bool], offsets: &[Ve
         queue.push_back(i);
     }
     let back: Vec<Vec<i64>> = offsets.iter().map(|o| o.iter().map(|x| -x).collect()).collect();
+    let n_moves = offsets.len();
     while let Some(t) = queue.pop_front() {
         let next = out[t].map_or(0, |m| m + grid.stride());
-        for o in &back {
+        for (a, o) in back.iter().enumerate() {
             if let Some(p) = grid.neighbour(t, o)
                 && codes[p] == 0
                 && out[p].is_none()
+                && !blocked.get(p * n_moves + a).copied().unwrap_or(false)
             {
                 out[p] = Some(next);
                 queue.push_back(p);
@@ -267,6 +333,7 @@ fn fewest_moves(grid: &LatentGrid, codes: &[u8], reached: &[bool], offsets: &[Ve
 /// One chunk's per-point results, in point order.
 #[derive(Default)]
 struct Part {
+    blocked: Vec<bool>,
     codes: Vec<u8>,
     reward: Vec<f64>,
     distance: Vec<f64>,
@@ -305,12 +372,16 @@ mod tests {
         let g = LatentGrid::at_step(&[0.0], &[4.0], &[1.0], 100);
         let codes = [0, 0, 1, 0, 0];
         let reached = [false, false, false, false, true];
-        let m = fewest_moves(&g, &codes, &reached, &[vec![1], vec![-1]]);
+        let m = fewest_moves(&g, &codes, &reached, &[vec![1], vec![-1]], &[]);
         assert_eq!(m, [None, None, None, Some(1), Some(0)]);
-        let open = fewest_moves(&g, &[0; 5], &reached, &[vec![1], vec![-1]]);
+        let open = fewest_moves(&g, &[0; 5], &reached, &[vec![1], vec![-1]], &[]);
         assert_eq!(open, [Some(4), Some(3), Some(2), Some(1), Some(0)]);
         // A one-way action set: only moves to the left; the target is out of reach.
-        let left = fewest_moves(&g, &[0; 5], &reached, &[vec![-1]]);
+        let left = fewest_moves(&g, &[0; 5], &reached, &[vec![-1]], &[]);
         assert_eq!(left, [None, None, None, None, Some(0)]);
+        // The move right from point 2 breaks a rule on the way: 0–2 must go around, and cannot.
+        let blocked = [false, false, false, false, true, false, false, false, false, false];
+        let through = fewest_moves(&g, &[0; 5], &reached, &[vec![1], vec![-1]], &blocked);
+        assert_eq!(through, [None, None, None, Some(1), Some(0)]);
     }
 }
