@@ -250,3 +250,14 @@ def generator(here: Path) -> tuple[np.random.Generator, Any, Kin]:
     rng = np.random.default_rng(parser.parse_args().seed)
     task = Task.load(here / "task.toml")
     return rng, task, Kin(task)
+
+
+def write_demos(kin: Kin, postures: NDArray[np.float64], most: int, here: Path) -> None:
+    """`here / "demos.csv"`: the `postures` every rule of the task admits at rest, at most
+    `most` of them (`keep_admissible`), with the task's joint names."""
+    from latentrl import Demonstrations, save_demos
+
+    kept = keep_admissible(kin, np.asarray(postures), most)
+    save_demos(Demonstrations(kept, kin.task.joint_names), here / "demos.csv")
+    print(f"{len(kept)} demos -> {here / 'demos.csv'}")
+

@@ -15,9 +15,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import generator, keep_admissible  # noqa: E402
+from _zoo import generator, write_demos  # noqa: E402
 
-from latentrl import Demonstrations, save_demos  # noqa: E402
 
 L1, L2, L3 = 0.30, 0.25, 0.08
 SHOULDER = {"l": -0.12, "r": 0.12}
@@ -53,9 +52,7 @@ def main() -> None:
             assert np.allclose(kin.pos(poses, "r_hand")[:2], [x + 0.075, y], atol=1e-5)
             Q.append(qq)
             centres.append((x, y))
-    postures = keep_admissible(kin, np.array(Q), 150)
-    save_demos(Demonstrations(postures, task.joint_names), HERE / "demos.csv")
-    print(f"{len(postures)} demos -> {HERE / 'demos.csv'}")
+    write_demos(kin, np.array(Q), 150, HERE)
 
 
 if __name__ == "__main__":

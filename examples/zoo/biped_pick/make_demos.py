@@ -17,9 +17,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import generator, keep_admissible  # noqa: E402
+from _zoo import generator, write_demos  # noqa: E402
 
-from latentrl import Demonstrations, save_demos  # noqa: E402
 
 
 def posture(names: tuple[str, ...], a: float, b: float) -> np.ndarray:
@@ -32,9 +31,7 @@ def main() -> None:
     ab = np.column_stack([rng.uniform(0.0, 1.0, 110), rng.uniform(0.0, 1.6, 110)])
     ab[0] = [0.0, 0.0]
     Q = np.array([posture(task.joint_names, a, b) for a, b in ab])
-    postures = keep_admissible(kin, Q, 100)
-    save_demos(Demonstrations(postures, task.joint_names), HERE / "demos.csv")
-    print(f"{len(postures)} demos -> {HERE / 'demos.csv'}")
+    write_demos(kin, Q, 100, HERE)
     pick = posture(task.joint_names, 0.95, 0.6)
     poses = kin.poses(pick)
     foot = kin.pos(poses, "l_foot")

@@ -17,9 +17,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import generator, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
+from _zoo import generator, box_penetration, chain_points, write_demos, solve_ik  # noqa: E402
 
-from latentrl import Demonstrations, save_demos  # noqa: E402
 
 BOXES = [([0.35, -0.75, 0.0], [0.85, -0.15, 0.25]), ([0.35, 0.15, 0.60], [0.85, 0.75, 0.63])]
 CHAIN = ["iiwa_link_2", "iiwa_link_4", "iiwa_link_6", "tray"]
@@ -46,9 +45,7 @@ def main() -> None:
         poses = kin.poses(q)
         if np.linalg.norm(kin.pos(poses, "tray") - goal) < 0.005:
             Q.append(q)
-    postures = keep_admissible(kin, np.array(Q), 120)
-    save_demos(Demonstrations(postures, task.joint_names), HERE / "demos.csv")
-    print(f"{len(postures)} demos -> {HERE / 'demos.csv'}")
+    write_demos(kin, np.array(Q), 120, HERE)
 
 
 if __name__ == "__main__":

@@ -17,9 +17,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import generator, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
+from _zoo import generator, box_penetration, chain_points, write_demos, solve_ik  # noqa: E402
 
-from latentrl import Demonstrations, save_demos  # noqa: E402
 
 DIVIDER = ([0.30, -0.015, 0.0], [0.70, 0.015, 0.22])
 CHAIN = ["panda_link3", "panda_link5", "panda_link7", "panda_hand", "tcp"]
@@ -47,9 +46,7 @@ def main() -> None:
             Q.append(q)
         elif len(Q) == 0:
             raise SystemExit("the start posture (row 0) has no IK solution")
-    postures = keep_admissible(kin, np.array(Q), 120)
-    save_demos(Demonstrations(postures, task.joint_names), HERE / "demos.csv")
-    print(f"{len(postures)} demos -> {HERE / 'demos.csv'}")
+    write_demos(kin, np.array(Q), 120, HERE)
 
 
 if __name__ == "__main__":

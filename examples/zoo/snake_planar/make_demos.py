@@ -14,9 +14,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import generator, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
+from _zoo import generator, box_penetration, chain_points, write_demos, solve_ik  # noqa: E402
 
-from latentrl import Demonstrations, save_demos  # noqa: E402
 
 WALL = ([0.06, -0.05, -0.05], [0.08, 0.10, 0.05])
 CHAIN = ["seg1", "seg2", "seg3", "seg4", "seg5", "seg6", "tip"]
@@ -40,9 +39,7 @@ def main() -> None:
         tip = kin.pos(kin.poses(q), "tip")[:2]
         if np.linalg.norm(tip - g) < 0.002:
             Q.append(q)
-    postures = keep_admissible(kin, np.array(Q), 120)
-    save_demos(Demonstrations(postures, task.joint_names), HERE / "demos.csv")
-    print(f"{len(postures)} demos -> {HERE / 'demos.csv'}")
+    write_demos(kin, np.array(Q), 120, HERE)
 
 
 if __name__ == "__main__":

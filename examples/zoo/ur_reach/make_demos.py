@@ -16,9 +16,8 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import generator, box_penetration, chain_points, keep_admissible, solve_ik  # noqa: E402
+from _zoo import generator, box_penetration, chain_points, write_demos, solve_ik  # noqa: E402
 
-from latentrl import Demonstrations, save_demos  # noqa: E402
 
 WALL = ([0.30, -0.30, 0.0], [0.36, 0.30, 0.25])
 CHAIN = ["upper_arm_link", "forearm_link", "wrist_1_link", "wrist_3_link", "tool0"]
@@ -41,9 +40,7 @@ def main() -> None:
         q, _ = solve_ik(residual, Q_NOM, kin.lower, kin.upper)
         if np.linalg.norm(kin.pos(kin.poses(q), "tool0") - goal) < 0.005:
             Q.append(q)
-    postures = keep_admissible(kin, np.array(Q), 120)
-    save_demos(Demonstrations(postures, task.joint_names), HERE / "demos.csv")
-    print(f"{len(postures)} demos -> {HERE / 'demos.csv'}")
+    write_demos(kin, np.array(Q), 120, HERE)
 
 
 if __name__ == "__main__":
