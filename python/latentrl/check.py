@@ -123,7 +123,7 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     module docs, with the settings `train` would derive where the task is silent; `model`: a
     fitted GPLVM (default: one fitted here, d = 2, seed 0, as `train` fits); `latent_margin`: the
     box's margin (default: `TrainPreset`'s)."""
-    from latentrl.derive import derive
+    from latentrl.derive import applied, derive
     from latentrl.experiments.presets import latent_box
     from latentrl.gplvm import GPLVM
     from latentrl.train import TrainPreset
@@ -136,12 +136,9 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     if model is None:
         model = GPLVM(n_components=2, random_state=0, max_iter=preset.gplvm_max_iter).fit(postures)
     low, high = latent_box(model.Z_, preset.latent_margin if latent_margin is None else latent_margin)
-    if demo_finding(task, postures).verdict == "will not learn":  # nothing to derive from: say why
-        derived = {}
-    else:
-        derived = {d.key: d.value for d in derive(task, model, low, high, postures, set(task.given))}
-    return check_task(task.replace(derived, origin=task.origin), postures, model, low, high,
-                      budget=(preset.trials, preset.episodes))
+    if demo_finding(task, postures).verdict != "will not learn":  # else nothing to derive from: say why
+        task = applied(task, derive(task, model, low, high, postures, set(task.given)))
+    return check_task(task, postures, model, low, high, budget=(preset.trials, preset.episodes))
 
 
 def check_task(task: Task, demos: NDArray[np.float64], model: Any, low: NDArray[np.float64],

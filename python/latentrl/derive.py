@@ -86,6 +86,11 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
     return out
 
 
+def applied(task: Task, derived: list[Derived] | tuple[Derived, ...]) -> Task:
+    """`task` with the `derived` settings set (its origin kept, for error messages)."""
+    return task.replace({d.key: d.value for d in derived}, origin=task.origin)
+
+
 def _survey(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.float64],
             demos: NDArray[np.float64]) -> dict[str, Any]:
     return _native.latent_survey(task._native, decoder=model.decoder_, latent_low=low, latent_high=high, demos=demos)

@@ -29,7 +29,7 @@ from latentrl import _native
 from latentrl._base import FORMAT_VERSION, PathLike, atomic_write, read_npz
 from latentrl.experiments.latent_runs import task_learner
 from latentrl.experiments.presets import LatentRun, latent_box, with_overrides
-from latentrl.experiments.runner import Setup, episodes_per_trial, run_in_process
+from latentrl.experiments.runner import Setup, end_counts, episodes_per_trial, run_in_process
 from latentrl.gplvm import GPLVM
 from latentrl.task import SHIPPED, Task, end_reasons
 
@@ -109,10 +109,9 @@ def train_latent_policy(
     starts = np.asarray(model.X_train_ if demos is None else demos, dtype=np.float64)
     low, high = latent_box(model.Z_, chosen.latent_margin)
     if isinstance(chosen, TrainPreset):  # a Task of yours (not a shipped experiment): derive what it leaves open
-        from latentrl.derive import derive
+        from latentrl.derive import applied, derive
 
-        task = task.replace({d.key: d.value for d in derive(task, model, low, high, starts, set(task.given))},
-                            origin=task.origin)
+        task = applied(task, derive(task, model, low, high, starts, set(task.given)))
     learner = task_learner(
         task, model, (low, high), starts, episodes=chosen.episodes, seed=chosen.seed, test_episodes=chosen.test_episodes
     )
@@ -133,12 +132,11 @@ def rollout_summary(ends: NDArray[Any], reached: NDArray[Any], returns: NDArray[
     """What rollout episodes of `task` did: "success" (the share that ended as the task's
     success, `target.hold_steps`; None where the task has no such rule), "reached_any_step" (the
     share within the reach radius after some step), the count of each ending, the mean return."""
-    names = end_reasons()
     rule = task.to_dict()["target"]["hold_steps"] > 0
     return {
-        "success": float((ends == names.index("success")).mean()) if rule else None,
+        "success": float((ends == end_reasons().index("success")).mean()) if rule else None,
         "reached_any_step": float(reached.mean()),
-        "ends": {names[c]: int((ends == c).sum()) for c in range(len(names))},
+        "ends": end_counts(ends),
         "mean_return": float(returns.mean()),
     }
 

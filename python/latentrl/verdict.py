@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from latentrl.experiments.runner import end_counts
 from latentrl.task import end_reasons
 from latentrl.train import format_rollout
 
@@ -95,7 +96,7 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
         verdict = "stopped improving below the target"
     names = end_reasons()
     late = ends[:, -fifth:]
-    late_ends = {names[c]: int((late == c).sum()) for c in range(len(names))}
+    late_ends = end_counts(late)
     steps: list[str] = []
     if verdict != "learnt":
         failing = late[~reached[:, -fifth:]]

@@ -215,7 +215,7 @@ def summarise_trial(arrays: Mapping[str, np.ndarray], name: str, trial: int) -> 
         "reached_last": float(reached[-window:].mean()),
         "passed_last": float(passed[-window:].mean()),
         "window": window,
-        "ends": _end_counts(ends),
+        "ends": end_counts(ends),
     }
     if array_key(name, "test_ends") in arrays:
         test_ends = arrays[array_key(name, "test_ends")][trial]
@@ -223,12 +223,13 @@ def summarise_trial(arrays: Mapping[str, np.ndarray], name: str, trial: int) -> 
             test_success=float(arrays[array_key(name, "test_reached")][trial].mean()),
             test_passed=float(arrays[array_key(name, "test_passed")][trial].mean()),
             test_mean_return=float(arrays[array_key(name, "test_returns")][trial].mean()),
-            test_ends=_end_counts(test_ends),
+            test_ends=end_counts(test_ends),
         )
     return summary
 
 
-def _end_counts(ends: np.ndarray) -> dict[str, int]:
+def end_counts(ends: np.ndarray) -> dict[str, int]:
+    """How many of `ends` (end codes) ended each way, by name, every ending listed."""
     return {label: int((ends == code).sum()) for code, label in END_CODES.items()}
 
 

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from latentrl.demos import load_demos
-from latentrl.derive import Derived, derive
+from latentrl.derive import Derived, applied, derive
 from latentrl.experiments.latent_runs import Fitted, latent_setup, run_fit
 from latentrl.experiments.presets import latent_box
 from latentrl.experiments.runner import Setup, finished_trials, load_arrays
@@ -78,7 +78,7 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
         low, high = latent_box(model.Z_, run.latent_margin)
         _DERIVED[key] = tuple(derive(task, model, low, high, demos, set(task.given)))
     settings = _DERIVED[key]
-    return task.replace({d.key: d.value for d in settings}, origin=task.origin), demos, model, settings
+    return applied(task, settings), demos, model, settings
 
 
 _DERIVED: dict[tuple[Any, ...], tuple[Derived, ...]] = {}
