@@ -22,9 +22,14 @@ from latentrl import _native
 from latentrl.experiments.presets import field_docs, with_overrides
 from latentrl.experiments.registry import experiments, task_schema
 from latentrl.experiments.results import environment, read_json, write_json
+from latentrl.recorded.options import DemoOptions
 from latentrl.run_lock import run_lock
 from latentrl.task import by_path, changed_since
 from latentrl.train import POLICIES, format_rollout
+
+DEMOS_HELP = ("demonstrated postures: .csv (header of joint names), .npz or .json; or a recording: a LeRobot dataset "
+              "folder, robomimic .hdf5/.h5, a ROS 1 .bag or ROS 2 bag folder (the [lerobot], [hdf5], [rosbag] extras; "
+              "docs/demos.md)")
 
 TASK_PREFIX = "task:"
 """Prefix of the argparse destinations of task keys (`task:learner.alpha`)."""
@@ -190,13 +195,14 @@ def build_parser() -> argparse.ArgumentParser:
                               "(the control: uniform moves, cannot learn) to run (default: all three)")
     rollout.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     fit = sub.add_parser("fit", help="fit a PCA or GPLVM to a demonstration file and save it (NPZ)")
-    fit.add_argument("demos", type=Path, help="demonstrated postures: .csv (header of joint names), .npz or .json")
+    fit.add_argument("demos", type=Path, help=DEMOS_HELP)
     fit.add_argument("--model", choices=("gplvm", "pca"), default="gplvm", help="the model (default: gplvm)")
     fit.add_argument("--n-components", type=_dimension, default=2,
                      help="latent dimension d, or auto (GPLVM: chosen by ARD relevance, docs/encoders.md; default: 2)")
     fit.add_argument("--seed", type=int, default=0, help="random_state of the GPLVM (default: 0)")
     fit.add_argument("--max-iter", type=int, default=1000, help="L-BFGS iteration cap of the GPLVM (default: 1000)")
     fit.add_argument("--out", type=Path, required=True, help="the model file to write (.npz; load with GPLVM.load)")
+    _add_preset_flags(fit, DemoOptions)
     plot = sub.add_parser("plot", help="redraw the figures of a results directory (finished trials only)")
     plot.add_argument("results", type=Path, help="a results directory of `latentrl run exp1|exp2|exp3`")
     plot.add_argument("--out", type=Path, help="where to write the figures (default: the results directory)")
@@ -243,7 +249,7 @@ def _add_training_flags(cmd: argparse.ArgumentParser, quick: str) -> None:
     from latentrl.experiments.training import TrainRun
 
     cmd.add_argument("task", type=Path, help="the task file (TOML; docs/tasks.md)")
-    cmd.add_argument("--demos", type=Path, required=True, help="demonstrated postures: .csv (header of joint names), .npz or .json")
+    cmd.add_argument("--demos", type=Path, required=True, help=DEMOS_HELP)
     cmd.add_argument("--model", type=Path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2)")
     cmd.add_argument("--quick", action="store_true", help=quick)
     cmd.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
@@ -436,14 +442,17 @@ def _fit(args: argparse.Namespace) -> int:
     auto = args.n_components == "auto"
     if auto and args.model == "pca":
         raise ValueError("--n-components auto: only --model gplvm chooses its dimension; give PCA an integer")
-    demos = load_demos(args.demos, min_postures=3 if auto else args.n_components + 1)
+    given = {f.name: getattr(args, f.name) for f in dataclasses.fields(DemoOptions) if getattr(args, f.name) is not None}
+    demos = load_demos(args.demos, min_postures=3 if auto else args.n_components + 1,
+                       **DemoOptions(**given).load_kwargs())
     if args.model == "pca":
         model: Any = PCA(n_components=args.n_components)
     else:
         model = GPLVM(n_components=args.n_components, max_iter=args.max_iter, random_state=args.seed)
     model.fit(demos.postures)
     model.save(args.out)
-    summary = {"model": type(model).__name__, "file": str(args.out), "postures": len(demos.postures),
+    episodes = {} if demos.episodes is None else {"episodes": len(set(demos.episodes.tolist()))}
+    summary = {"model": type(model).__name__, "file": str(args.out), "postures": len(demos.postures), **episodes,
                "joint_names": list(demos.joint_names), **model.get_params()}
     if args.model == "gplvm":
         summary.update(nll=model.nll_, converged=model.converged_, n_iter=model.n_iter_, theta=model.theta_.tolist(),
@@ -532,6 +541,10 @@ def _check_writable(out: Path, *, file: bool) -> None:
         raise ValueError(f"--out {out}: cannot write under {parent}")
 
 
+RECORDING_LIBRARIES = ("pyarrow", "h5py", "rosbags")
+"""The libraries of the recording extras ([lerobot], [hdf5], [rosbag])."""
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
     args = build_parser().parse_args(argv)
@@ -551,6 +564,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"latentrl: error: {err}", file=sys.stderr)
         return 1
     except ModuleNotFoundError as err:
+        if err.name in RECORDING_LIBRARIES:  # its message names the extra (latentrl.recorded.libraries)
+            print(f"latentrl: error: {err}", file=sys.stderr)
+            return 1
         if err.name != "matplotlib":
             raise
         print("latentrl: error: figures need matplotlib: pip install 'latentrl[plot]'", file=sys.stderr)

@@ -1,10 +1,13 @@
-"""Demonstrated postures with their joint names, read from and written to CSV, NPZ or JSON.
+"""Demonstrated postures with their joint names, read from and written to CSV, NPZ or JSON, and
+read from recordings (LeRobot datasets, robomimic HDF5, ROS bags: `latentrl.recorded`).
 
 Formats (by extension):
 
 - ``.csv``: a header row of joint names, then one posture per row.
-- ``.npz``: arrays ``postures`` (N, D) and ``joint_names`` (D,) of strings.
+- ``.npz``: arrays ``postures`` (N, D) and ``joint_names`` (D,) of strings (and, where the
+  demonstrations have them, ``episodes`` and ``frames`` (N,)).
 - ``.json``: ``{"joint_names": [...], "postures": [[...], ...]}``.
+- recordings (read only): a LeRobot dataset folder, ``.hdf5``/``.h5``, ``.bag``, a ROS 2 bag folder.
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ from __future__ import annotations
 import csv
 import io
 import json
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -21,18 +24,26 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl._base import PathLike, atomic_write, read_npz
+from latentrl.recorded import KINDS, open_recording, read_frames, recording_kind
+from latentrl.recorded.frames import renamed
+from latentrl.recorded.sampling import farthest_points
 
 
 @dataclass(frozen=True, eq=False)
 class Demonstrations:
-    """Demonstrated postures (N, D), one column per joint, and the joints' names (D,).
+    """Demonstrated postures (N, D), one column per joint, and the joints' names (D,); for
+    postures taken from a recording, the episode (N,) each comes from and its frame index in
+    that episode (N,), else None.
 
     Checked on construction: names non-empty and unique, at least one posture, one column
-    per name, every value finite. `postures` is stored as a read-only float64 copy.
+    per name, every value finite, one episode and frame index per posture. `postures` is stored
+    as a read-only float64 copy, `episodes` and `frames` as read-only int64 ones.
     """
 
     postures: NDArray[np.float64]
     joint_names: tuple[str, ...]
+    episodes: NDArray[np.int64] | None = None
+    frames: NDArray[np.int64] | None = None
 
     def __post_init__(self) -> None:
         names = tuple(self.joint_names)
@@ -56,6 +67,24 @@ class Demonstrations:
         postures.flags.writeable = False
         object.__setattr__(self, "postures", postures)
         object.__setattr__(self, "joint_names", names)
+        for field in ("episodes", "frames"):
+            value = getattr(self, field)
+            if value is None:
+                continue
+            index = np.array(value)
+            if index.shape != (len(postures),) or index.dtype.kind not in "iu":
+                raise ValueError(f"{field}: expected {len(postures)} integers (one per posture), "
+                                 f"got dtype {index.dtype} shape {index.shape}")
+            index = index.astype(np.int64)
+            index.flags.writeable = False
+            object.__setattr__(self, field, index)
+
+    def subset(self, rows: Sequence[int] | NDArray[np.intp]) -> Demonstrations:
+        """These demonstrations' postures `rows` (with their episode and frame indices)."""
+        pick = np.asarray(rows, dtype=np.intp)
+        return Demonstrations(self.postures[pick], self.joint_names,
+                              None if self.episodes is None else self.episodes[pick],
+                              None if self.frames is None else self.frames[pick])
 
     def __repr__(self) -> str:
         return f"Demonstrations({self.postures.shape[0]} postures of {list(self.joint_names)})"
@@ -123,7 +152,7 @@ def _read_npz(path: Path) -> Demonstrations:
             "joint_names: expected a 1-D array of strings, "
             f"got dtype {names.dtype} shape {names.shape}"
         )
-    return Demonstrations(postures, tuple(str(name) for name in names))
+    return Demonstrations(postures, tuple(str(name) for name in names), arrays.get("episodes"), arrays.get("frames"))
 
 
 def _write_csv(demos: Demonstrations, fh: IO[bytes]) -> None:
@@ -140,7 +169,9 @@ def _write_json(demos: Demonstrations, fh: IO[bytes]) -> None:
 
 
 def _write_npz(demos: Demonstrations, fh: IO[bytes]) -> None:
-    np.savez(fh, postures=demos.postures, joint_names=np.array(demos.joint_names, dtype=str))
+    arrays: dict[str, Any] = {"postures": demos.postures, "joint_names": np.array(demos.joint_names, dtype=str)}
+    arrays.update((k, v) for k, v in (("episodes", demos.episodes), ("frames", demos.frames)) if v is not None)
+    np.savez(fh, **arrays)
 
 
 _FORMATS: dict[
@@ -159,7 +190,8 @@ def _format(
         return _FORMATS[path.suffix.lower()]
     except KeyError:
         raise ValueError(
-            f"{path}: unsupported extension {path.suffix!r}; expected one of {', '.join(_FORMATS)}"
+            f"{path}: unsupported extension {path.suffix!r}; expected one of {', '.join(_FORMATS)}, "
+            f"or a recording: {KINDS}"
         ) from None
 
 
@@ -171,7 +203,7 @@ def _select(demos: Demonstrations, expected: Sequence[str]) -> Demonstrations:
             f"joint names do not match the expected ones: missing {missing}, unknown {unknown}"
         )
     columns = [demos.joint_names.index(name) for name in expected]
-    return Demonstrations(demos.postures[:, columns], tuple(expected))
+    return Demonstrations(demos.postures[:, columns], tuple(expected), demos.episodes, demos.frames)
 
 
 MAX_DEMO_FILE_BYTES = 256 * 2**20
@@ -179,15 +211,65 @@ MAX_DEMO_FILE_BYTES = 256 * 2**20
 
 
 def load_demos(
-    path: PathLike, *, expected_joints: Sequence[str] | None = None, min_postures: int = 1
+    path: PathLike,
+    *,
+    expected_joints: Sequence[str] | None = None,
+    min_postures: int = 1,
+    max_postures: int | None = None,
+    joint_map: Mapping[str, str] | None = None,
+    degrees: bool = False,
+    key: str | None = None,
+    joint_names: Sequence[str] | None = None,
 ) -> Demonstrations:
-    """Reads demonstrations from a ``.csv``, ``.npz`` or ``.json`` file.
+    """Reads demonstrations from a ``.csv``, ``.npz`` or ``.json`` file, or from a recording: a
+    LeRobot dataset folder, robomimic HDF5 (``.hdf5``, ``.h5``), a ROS 1 bag (``.bag``) or a ROS 2
+    bag folder (docs/demos.md; each needs its extra: `latentrl.recorded`).
 
-    With `expected_joints`, the file must name exactly those joints, and the columns are
-    returned in that order. Fewer than `min_postures` postures is an error. Every problem
-    is a ValueError naming the file and what is wrong where.
+    `joint_map` renames joints (old → new) before they are matched. With `expected_joints`, a
+    file of postures must name exactly those joints; a recording must have them and its other
+    joints (a gripper, a wheel) are dropped; the columns are returned in that order. `degrees`:
+    the values are degrees, converted to radians (a recording's kept joint beyond ±2π is refused
+    without it, as looking like degrees). `key`: where a recording keeps the joint positions (the
+    LeRobot feature, default ``observation.state``; the HDF5 obs key, default
+    ``robot0_joint_pos``; the ROS topic, default ``/joint_states``); `joint_names`: the names of
+    a recording that has none. A recording's episode and frame index per posture are kept
+    (`Demonstrations.episodes`, `.frames`); one that would bring more than
+    `latentrl.recorded.MAX_RECORDED_VALUES` values into memory is refused before it is read,
+    unless `max_postures` is given (then every k-th frame of each episode is read).
+
+    `max_postures`: at most that many postures, chosen by farthest-point sampling in joint space
+    from the first one (`latentrl.recorded.sampling.farthest_points`), in their recorded order.
+    Fewer than `min_postures` postures is an error. Every problem is a ValueError naming the
+    file (and field) and what is wrong where; a missing format library a ModuleNotFoundError
+    naming the extra to install.
     """
     path = Path(path)
+    if max_postures is not None and not (isinstance(max_postures, int) and max_postures >= 1):
+        raise ValueError(f"max_postures must be an int >= 1 or None, got {max_postures!r}")
+    kind = recording_kind(path)
+    if kind is None:
+        if key is not None or joint_names is not None:
+            raise ValueError(f"{path}: a file of postures names its joints; key and joint names are options of "
+                             f"recordings ({KINDS})")
+        demos = _load_file(path, expected_joints, joint_map or {}, degrees)
+    else:
+        path.stat()  # a missing file: FileNotFoundError, an OSError
+        names = None if joint_names is None else tuple(joint_names)
+        with open_recording(path, kind, key=key, joint_names=names) as recording:
+            frames = read_frames(recording, expected_joints=expected_joints, joint_map=joint_map, degrees=degrees,
+                                 max_postures=max_postures)
+        demos = Demonstrations(frames.values, frames.names, frames.episodes, frames.frames)
+    if max_postures is not None and len(demos.postures) > max_postures:
+        demos = demos.subset(farthest_points(demos.postures, max_postures))
+    if len(demos.postures) < min_postures:
+        raise ValueError(
+            f"{path}: {len(demos.postures)} postures, expected at least {min_postures}"
+        )
+    return demos
+
+
+def _load_file(path: Path, expected_joints: Sequence[str] | None, joint_map: Mapping[str, str],
+               degrees: bool) -> Demonstrations:
     read, _ = _format(path)
     size = path.stat().st_size  # a missing file: FileNotFoundError, an OSError
     if not path.is_file():
@@ -199,16 +281,16 @@ def load_demos(
                          "(it is read whole); demonstrations are postures, not trajectories of millions of rows")
     try:
         demos = read(path)
+        if joint_map:
+            demos = Demonstrations(demos.postures, renamed(demos.joint_names, joint_map), demos.episodes, demos.frames)
         if expected_joints is not None:
             demos = _select(demos, tuple(expected_joints))
     except (ValueError, csv.Error) as err:
         raise ValueError(f"{path}: {err}") from err
     except RecursionError as err:
         raise ValueError(f"{path}: nested too deeply to read") from err
-    if len(demos.postures) < min_postures:
-        raise ValueError(
-            f"{path}: {len(demos.postures)} postures, expected at least {min_postures}"
-        )
+    if degrees:
+        demos = Demonstrations(np.radians(demos.postures), demos.joint_names, demos.episodes, demos.frames)
     return demos
 
 

@@ -3,6 +3,7 @@ the one runner (results layout of SPEC §5, resumable) and saved as `DIR/policy.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 from dataclasses import dataclass
@@ -13,6 +14,8 @@ from typing import Any
 import numpy as np
 
 from latentrl.demos import load_demos
+from latentrl.recorded import recording_kind
+from latentrl.recorded.options import DemoOptions
 from latentrl.derive import Derived, applied, derive
 from latentrl.experiments.latent_runs import Fitted, latent_setup, run_fit
 from latentrl.experiments.presets import latent_box
@@ -23,13 +26,14 @@ from latentrl.train import LatentPolicy, TrainPreset
 
 
 @dataclass(frozen=True)
-class TrainRun(TrainPreset):
-    """A training run of `latentrl train`: the preset, the task file, the demos and the model."""
+class TrainRun(TrainPreset, DemoOptions):
+    """A training run of `latentrl train`: the preset, the task file, the demos (and how they are
+    read), and the model."""
 
     task_file: str = ""
     """The task file (TOML), as given."""
     demos: str = ""
-    """The demonstrations (CSV with a header of joint names, NPZ or JSON), as given."""
+    """The demonstrations (CSV with a header of joint names, NPZ, JSON, or a recording: docs/demos.md), as given."""
     model: str = ""
     """A saved GPLVM to use instead of fitting one to the demos ("" = fit, d = 2)."""
 
@@ -42,10 +46,13 @@ class TrainRun(TrainPreset):
 
 
 @lru_cache(maxsize=2)
-def _load(task_file: str, overrides: str, demos: str, model: str,
+def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, model: str,
           seed: int, max_iter: int, encoder: str) -> tuple[Task, np.ndarray, GPLVM]:
     task = Task.load(task_file).replace(json.loads(overrides))
-    loaded = load_demos(demos, min_postures=3)
+    # A recording's other joints (a gripper, a wheel) are dropped; a file of postures names the robot's.
+    recorded = recording_kind(Path(demos)) is not None
+    loaded = load_demos(demos, min_postures=3, expected_joints=task.joint_names if recorded else None,
+                        **options.load_kwargs())
     postures = task.demo_postures(loaded.joint_names, loaded.postures, demos)
     gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder)
     if model:
@@ -68,7 +75,8 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
     """`fitted`, and the settings `latentrl.derive` derived for it (cached per task, fit and
     margin)."""
     overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
-    task, demos, model = _load(run.task_file, overrides, run.demos, run.model, run.seed, run.gplvm_max_iter,
+    options = DemoOptions(**{f.name: getattr(run, f.name) for f in dataclasses.fields(DemoOptions)})
+    task, demos, model = _load(run.task_file, overrides, run.demos, options, run.model, run.seed, run.gplvm_max_iter,
                                run.encoder)
     if out is not None:
         model = run_fit(out, run.latent_margin, lambda: Fitted.of_model(model, run.latent_margin)).model

@@ -1,0 +1,93 @@
+"""An HDF5 file in the robomimic layout as a `Recording`: one group ``data/demo_<i>`` per episode,
+the joint positions in ``data/demo_<i>/obs/<key>`` (N, D). Joint names: a ``joint_names``
+attribute on that dataset or on ``data``, else given. Needs h5py (``pip install 'latentrl[hdf5]'``)."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl.recorded.frames import Episode
+from latentrl.recorded.libraries import needs
+
+DEFAULT_KEY = "robot0_joint_pos"
+DEMO = re.compile(r"demo_(\d+)")
+NAMES_ATTRIBUTE = "joint_names"
+
+
+def _names(value: Any) -> tuple[str, ...]:
+    items = np.atleast_1d(np.asarray(value))
+    return tuple(item.decode() if isinstance(item, bytes) else str(item) for item in items)
+
+
+class RobomimicFile:
+    """Reads ``data/demo_*/obs/<key>`` (default ``robot0_joint_pos``) of every demo group."""
+
+    def __init__(self, path: Path, key: str | None, joint_names: tuple[str, ...] | None) -> None:
+        h5py = needs("h5py", "HDF5", "hdf5")
+        self.path, self.field = path, key or DEFAULT_KEY
+        try:
+            self._file = h5py.File(path, "r")
+        except OSError as err:
+            raise ValueError(f"{path}: not a readable HDF5 file (cut short?): {err}") from err
+        try:
+            self.episodes, datasets = self._episodes()
+            self.names = joint_names or self._recorded_names(datasets)
+            if datasets and datasets[0].shape[1] != len(self.names):
+                raise ValueError(f"{path}: {self.field} has {datasets[0].shape[1]} values per frame, "
+                                 f"for {len(self.names)} joint names {list(self.names)}")
+        except BaseException:
+            self._file.close()
+            raise
+
+    def _episodes(self) -> tuple[tuple[Episode, ...], list[Any]]:
+        data = self._file.get("data")
+        if data is None or not hasattr(data, "keys"):
+            raise ValueError(f"{self.path}: no group 'data' (the robomimic layout: data/demo_<i>/obs/<key>)")
+        demos = sorted((int(m.group(1)), name) for name in data.keys() if (m := DEMO.fullmatch(name)))
+        if not demos:
+            raise ValueError(f"{self.path}: no episodes (no data/demo_<i> groups; data has {sorted(data.keys())})")
+        self._data: dict[int, Any] = {}
+        episodes, width = [], None
+        for index, name in demos:
+            field = f"data/{name}/obs/{self.field}"
+            dataset = self._file.get(field)
+            if dataset is None or not hasattr(dataset, "shape"):
+                obs = self._file.get(f"data/{name}/obs")
+                keys = sorted(obs.keys()) if obs is not None and hasattr(obs, "keys") else []
+                raise ValueError(f"{self.path}: no dataset {field}; data/{name}/obs has {keys} (choose with --demos-key)")
+            if len(dataset.shape) != 2 or dataset.dtype.kind not in "iuf":
+                raise ValueError(f"{self.path}: {field} is {dataset.dtype} of shape {dataset.shape}, "
+                                 "expected numbers (frames, joints)")
+            if width is not None and dataset.shape[1] != width:
+                raise ValueError(f"{self.path}: {field} has {dataset.shape[1]} values per frame, the episodes "
+                                 f"before it {width} (mixed shapes)")
+            width = dataset.shape[1]
+            self._data[index] = dataset
+            episodes.append(Episode(index, dataset.shape[0], f"{self.path}: {field}"))
+        return tuple(episodes), [self._data[i] for i, _ in demos]
+
+    def _recorded_names(self, datasets: list[Any]) -> tuple[str, ...]:
+        for holder in [*datasets[:1], self._file["data"]]:
+            if NAMES_ATTRIBUTE in holder.attrs:
+                return _names(holder.attrs[NAMES_ATTRIBUTE])
+        raise ValueError(f"{self.path}: no {NAMES_ATTRIBUTE!r} attribute on data/demo_*/obs/{self.field} or data; "
+                         "give the joint names (--joint-names a,b,…)")
+
+    def read(self, episode: Episode, step: int) -> NDArray[np.float64]:
+        """Every `step`-th frame of the episode's dataset."""
+        try:
+            return np.asarray(self._data[episode.index][::step], dtype=np.float64)
+        except OSError as err:
+            raise ValueError(f"{episode.where}: cannot be read (cut short?): {err}") from err
+
+    def __enter__(self) -> RobomimicFile:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, err: BaseException | None, tb: TracebackType | None) -> None:
+        self._file.close()

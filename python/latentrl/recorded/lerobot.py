@@ -1,0 +1,117 @@
+"""A LeRobot dataset (v2.x layout) as a `Recording`: ``meta/info.json`` names the features (the
+state one's ``names`` are the joints), ``data/chunk-*/episode_*.parquet`` hold one episode each.
+Needs pyarrow (``pip install 'latentrl[lerobot]'``)."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from types import TracebackType
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from latentrl.recorded.frames import Episode
+from latentrl.recorded.libraries import needs
+
+DEFAULT_KEY = "observation.state"
+EPISODE_FILE = re.compile(r"episode_(\d+)\.parquet")
+
+
+def feature_names(names: Any, where: str) -> tuple[str, ...] | None:
+    """A feature's ``names`` in info.json: a list of strings, or a dict with one such list (v2.0's
+    ``{"motors": [...]}``); None where there are none."""
+    if names is None:
+        return None
+    if isinstance(names, dict) and len(names) == 1:
+        names = next(iter(names.values()))
+    if isinstance(names, list) and all(isinstance(n, str) for n in names):
+        return tuple(names)
+    raise ValueError(f"{where}: names {names!r} are not a list of joint names")
+
+
+class LeRobotDataset:
+    """Reads the feature `key` (default ``observation.state``) of every episode's parquet file."""
+
+    def __init__(self, path: Path, key: str | None, joint_names: tuple[str, ...] | None) -> None:
+        self._pa = needs("pyarrow", "a LeRobot dataset", "lerobot")
+        self._pq = needs("pyarrow.parquet", "a LeRobot dataset", "lerobot")
+        self._pc = needs("pyarrow.compute", "a LeRobot dataset", "lerobot")
+        self.path, self.field = path, key or DEFAULT_KEY
+        info_path = path / "meta" / "info.json"
+        try:
+            info = json.loads(info_path.read_text(encoding="utf-8"))
+        except (json.JSONDecodeError, UnicodeDecodeError) as err:
+            raise ValueError(f"{info_path}: not valid JSON ({err})") from err
+        features = info.get("features") if isinstance(info, dict) else None
+        if not isinstance(features, dict):
+            raise ValueError(f"{info_path}: no features (a LeRobot v2.x info.json has a features table)")
+        if str(info.get("codebase_version", "v2")).startswith("v3"):
+            raise ValueError(f"{info_path}: a LeRobot {info['codebase_version']} dataset; latentrl reads the v2.x layout "
+                             "(one data/chunk-*/episode_*.parquet per episode)")
+        feature = features.get(self.field)
+        if not isinstance(feature, dict):
+            vectors = sorted(k for k, v in features.items() if isinstance(v, dict) and v.get("dtype") in ("float32", "float64"))
+            raise ValueError(f"{info_path}: no feature {self.field!r}; its float features are {vectors} "
+                             "(choose one with --demos-key)")
+        where = f"{info_path}: features.{self.field}"
+        names = joint_names or feature_names(feature.get("names"), where)
+        if names is None:
+            raise ValueError(f"{where} has no names; give the joint names (--joint-names a,b,…)")
+        shape = feature.get("shape")
+        if shape is not None and list(shape) != [len(names)]:
+            raise ValueError(f"{where}: shape {shape} for {len(names)} joint names {list(names)}")
+        self.names = names
+        self.episodes = self._episodes(info, info_path)
+
+    def _episodes(self, info: dict[str, Any], info_path: Path) -> tuple[Episode, ...]:
+        files = {}
+        for file in sorted(self.path.glob("data/chunk-*/episode_*.parquet")):
+            match = EPISODE_FILE.fullmatch(file.name)
+            if match:
+                files[int(match.group(1))] = file
+        expected = info.get("total_episodes")
+        if isinstance(expected, int) and expected != len(files):
+            raise ValueError(f"{info_path}: total_episodes is {expected}, but {self.path / 'data'} holds {len(files)} "
+                             "episode files (data/chunk-*/episode_*.parquet)")
+        episodes = []
+        for index, file in sorted(files.items()):
+            parquet = self._open(file)
+            if parquet.schema_arrow.get_field_index(self.field) < 0:
+                raise ValueError(f"{file}: no column {self.field!r}; it has {parquet.schema_arrow.names}")
+            episodes.append(Episode(index, parquet.metadata.num_rows, str(file)))
+        return tuple(episodes)
+
+    def _open(self, file: Path) -> Any:
+        try:
+            return self._pq.ParquetFile(file)
+        except (self._pa.ArrowException, OSError) as err:
+            raise ValueError(f"{file}: not a readable parquet file (cut short?): {err}") from err
+
+    def read(self, episode: Episode, step: int) -> NDArray[np.float64]:
+        """Every `step`-th frame of the episode's state column; a frame whose length is not the
+        number of joints is a ValueError naming the file, column and frame."""
+        where = f"{episode.where}: column {self.field!r}"
+        try:
+            column = self._open(Path(episode.where)).read(columns=[self.field]).column(0).combine_chunks()
+        except self._pa.ArrowException as err:
+            raise ValueError(f"{where}: cannot be read (cut short?): {err}") from err
+        if not self._pa.types.is_list(column.type) and not self._pa.types.is_fixed_size_list(column.type) \
+                and not self._pa.types.is_large_list(column.type):
+            raise ValueError(f"{where}: holds {column.type}, not a list of joint values per frame")
+        lengths = self._pc.list_value_length(column).to_numpy(zero_copy_only=False)
+        odd = np.flatnonzero(~(lengths == len(self.names)))  # a null frame's length is NaN
+        if odd.size:
+            found = "no value" if np.isnan(lengths[odd[0]]) else f"{lengths[odd[0]]:g} values"
+            raise ValueError(f"{where}: frame {odd[0]} has {found}, expected {len(self.names)} "
+                             f"(one per joint: {list(self.names)})")
+        values = np.asarray(column.flatten().to_numpy(zero_copy_only=False), dtype=np.float64)
+        return values.reshape(len(column), len(self.names))[::step]
+
+    def __enter__(self) -> LeRobotDataset:
+        return self
+
+    def __exit__(self, kind: type[BaseException] | None, err: BaseException | None, tb: TracebackType | None) -> None:
+        return None
