@@ -127,6 +127,15 @@ def test_native_projection_encodes_one_posture_as_the_batch(model):
     assert projected.loop_encoder_ is projected.native_projection_
 
 
+def test_the_tracking_encoder_fits_the_gp_model_and_projects_without_a_command(model):
+    tracking = GPLVM(encoder="tracking").fit(model.X_train_)
+    np.testing.assert_array_equal(tracking.Z_, model.Z_)
+    assert tracking.fitted_encoder_ == "gp"
+    X = held_out(model, n=3)
+    np.testing.assert_array_equal(tracking.loop_encoder_.encode(X), model.native_projection_.encode(X))
+    np.testing.assert_array_equal(tracking.transform(X), model.transform(X, method="projection"))
+
+
 @pytest.mark.parametrize(
     "call, match",
     [

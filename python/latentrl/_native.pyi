@@ -98,10 +98,17 @@ class Projection:
     """The iterative-projection encoder posture → latent of a GPLVM decoder (docs/encoders.md)."""
 
     def __new__(
-        cls, decoder: GpMap, postures: NDArray[np.float64], *, max_iter: int = 200, margin: float = 0.5
+        cls,
+        decoder: GpMap,
+        postures: NDArray[np.float64],
+        *,
+        max_iter: int = 200,
+        margin: float = 0.5,
+        tracking: bool = False,
     ) -> Projection:
         """The projection under `decoder` (a GpMap latent → posture) fitted to `postures` (N, D),
-        with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`."""
+        with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`;
+        `tracking`: after a move, search from the commanded latent point (docs/encoders.md)."""
     def encode(self, postures: NDArray[np.float64]) -> NDArray[np.float64]:
         """Latent points (M, d) of `postures` (M, D), in parallel."""
     def encode_one(self, posture: NDArray[np.float64]) -> NDArray[np.float64]:

@@ -16,7 +16,7 @@ from latentrl._validation import as_matrix, int_at_least, positive
 from latentrl.inverse import Projection, fit_gp_encoder
 from latentrl.pca import PCA, check_n_components
 
-ENCODERS = ("gp", "projection", "back_constrained")
+ENCODERS = ("gp", "projection", "back_constrained", "tracking")
 
 #: Standard deviation of the perturbation of the (unit-scaled) PCA start for each restart.
 RESTART_SCALE = 0.5
@@ -58,7 +58,7 @@ class GPLVM(Estimator):
         the fit with the lowest objective is kept.
     random_state : int or None, default=None
         Seed of the restarts' perturbations.
-    encoder : {"gp", "projection", "back_constrained"}, default="gp"
+    encoder : {"gp", "projection", "back_constrained", "tracking"}, default="gp"
         Inverse map of `transform`: the out-of-sample GP fitted onto `Z_` after the fit (the
         paper's), the iterative projection, or the back-constraint (Lawrence & Quiñonero-
         Candela 2006): the latent points are fitted as a smooth function of the postures,
@@ -66,7 +66,10 @@ class GPLVM(Estimator):
         through the same NLL), so `transform(X_train)` is `Z_` and a new posture encodes with
         one kernel evaluation. "gp" and "projection" fit the same model (either may be
         chosen at `transform`); "back_constrained" fits another (with it, `transform` takes
-        "back_constrained" or "projection").
+        "back_constrained" or "projection"). "tracking" fits the "gp" model; the RL loop then
+        encodes a reached posture by the projection searched from the latent point the move
+        commanded (reconstruction error only), so a posture the plant tracked keeps its point
+        (docs/encoders.md); `transform`, which has no commanded point, projects.
     tol : float, default=1e-6
         L-BFGS-B stops when the relative decrease of the objective (ftol) or the largest
         projected gradient component (gtol) falls below `tol` (scipy's `tol`).
@@ -116,8 +119,8 @@ class GPLVM(Estimator):
         The same iterative projection in Rust, the one the RL loop runs (docs/encoders.md:
         how closely the two agree).
     loop_encoder_ : GpMap or latentrl._native.Projection
-        The posture → Z map of the native RL loop, by the `encoder` parameter: `encoder_`, or
-        `native_projection_` for "projection".
+        The posture → Z map of the native RL loop, by the `encoder` parameter: `encoder_`,
+        `native_projection_` for "projection", its tracking mode for "tracking".
     n_features_in_ : int
         Number of joints D.
     feature_names_in_ : ndarray (D,) of str objects
@@ -282,8 +285,10 @@ class GPLVM(Estimator):
 
     @property
     def loop_encoder_(self) -> GpMap | _native.Projection:
-        """The posture → Z map of the native RL loop, by the `encoder` parameter: `encoder_`, or
-        `native_projection_` for "projection"."""
+        """The posture → Z map of the native RL loop, by the `encoder` parameter: `encoder_`,
+        `native_projection_` for "projection", its tracking mode for "tracking"."""
+        if self.encoder == "tracking":
+            return _native.Projection(self.decoder_, self.X_train_, tracking=True)
         return self.native_projection_ if self.encoder == "projection" else self.encoder_
 
     @property
@@ -324,11 +329,11 @@ class GPLVM(Estimator):
         method = self.encoder if method is None else method
         self._check_encoder(method)
         fitted = self.fitted_encoder_
-        if method not in (fitted, "projection"):
+        if method not in (fitted, "projection", "tracking"):
             raise ValueError(f"method {method!r}: this GPLVM was fitted with the {fitted!r} encoder, "
                              f"so transform takes {fitted!r} or 'projection'")
         X = self._check_X(X)
-        if method == "projection":
+        if method in ("projection", "tracking"):
             return self.projection_.encode(X)
         return self.encoder_.predict_mean(X)
 

@@ -16,6 +16,13 @@ pub trait Encode: std::fmt::Debug + Send + Sync {
     /// Encodes `posture` (length D) into `z` (length d), allocation-free with buffers of this
     /// map (others are replaced once); lengths and finiteness are the caller's contract.
     fn encode_into(&self, posture: &[f64], z: &mut [f64], scratch: &mut EncodeScratch);
+    /// Encodes `posture`, reached after commanding the latent point `near`, into `z`: maps
+    /// that can use where the move was aimed (a tracking [`Projection`]) search from there;
+    /// the others ignore it ([`Encode::encode_into`]).
+    fn encode_near_into(&self, posture: &[f64], near: &[f64], z: &mut [f64], scratch: &mut EncodeScratch) {
+        let _ = near;
+        self.encode_into(posture, z, scratch);
+    }
 }
 
 /// Buffers of an [`Encode`] map.
@@ -69,6 +76,15 @@ impl Encode for Projection {
         }
         if let EncodeScratch::Projection(s) = scratch {
             Projection::encode_into(self, posture, z, s);
+        }
+    }
+
+    fn encode_near_into(&self, posture: &[f64], near: &[f64], z: &mut [f64], scratch: &mut EncodeScratch) {
+        if !matches!(scratch, EncodeScratch::Projection(_)) {
+            *scratch = self.encode_scratch();
+        }
+        if let EncodeScratch::Projection(s) = scratch {
+            Projection::encode_near_into(self, posture, near, z, s);
         }
     }
 }

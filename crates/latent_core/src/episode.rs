@@ -133,7 +133,7 @@ pub fn transition<P: Plant>(
     }
     let outcome = plant.step(&s.target, &mut s.reached);
     if outcome.end.is_none_or(|e| !e.is_terminal()) {
-        space.encode(&s.reached, &mut s.next, &mut s.maps);
+        space.encode_near(&s.reached, z_target, &mut s.next, &mut s.maps);
     }
     StepResult {
         reward: outcome.reward,
@@ -715,6 +715,40 @@ mod tests {
         }
         assert!(l.values(&[f64::NAN]).is_err());
         assert!(l.set_weights(&[1.0]).is_err());
+    }
+
+    /// A decoder folded onto itself (z and −z decode to the same posture z²): after a move to
+    /// 0.6 the plain projection starts from the first nearest demo (−0.6), the tracking one keeps
+    /// the commanded point.
+    #[test]
+    fn a_tracking_encoder_keeps_the_commanded_point() {
+        use crate::{GpMap, Projection, ProjectionConfig, SeKernel};
+        use nalgebra::DMatrix;
+        let latent = DMatrix::from_fn(1, 21, |_, j| -1.0 + 0.1 * j as f64);
+        let postures = latent.map(|z| z * z);
+        let decoder = GpMap::new(latent, postures.clone(), SeKernel::new([1.0, 0.1, 1e-6]).unwrap()).unwrap();
+        let tracking = ProjectionConfig {
+            tracking: true,
+            ..ProjectionConfig::default()
+        };
+        let encoder = Projection::new(&decoder, postures, tracking).unwrap();
+        let space = StateSpace::Latent {
+            decoder: &decoder,
+            encoder: &encoder,
+        };
+        let bounds = Bounds {
+            low: &[-1.0],
+            high: &[1.0],
+            variance_threshold: None,
+            penalty: -1.0,
+        };
+        let mut plant = Corridor { x: 0.0 };
+        let mut s = TransitionScratch::new(&space, 1, 1);
+        for z in [0.6, -0.6, 0.25] {
+            let step = transition(&mut plant, &space, &bounds, &[z], &mut s);
+            assert!(step.moved && step.end.is_none());
+            assert!((s.next[0] - z).abs() < 1e-6, "commanded {z}, encoded {}", s.next[0]);
+        }
     }
 
     #[test]

@@ -25,6 +25,10 @@ pub struct ProjectionConfig {
     /// The search box is the latent points' bounding box widened by this share of its extent
     /// per side (as the Python reference's `margin`).
     pub margin: f64,
+    /// After a move, search from the commanded latent point instead
+    /// ([`Self::encode_near_into`]'s tracking mode): the reconstruction error only, so a
+    /// posture the plant tracked encodes to the point that commanded it.
+    pub tracking: bool,
 }
 
 impl Default for ProjectionConfig {
@@ -32,6 +36,7 @@ impl Default for ProjectionConfig {
         Self {
             max_iter: 200,
             margin: 0.5,
+            tracking: false,
         }
     }
 }
@@ -45,6 +50,7 @@ pub struct Projection {
     low: Vec<f64>,
     high: Vec<f64>,
     max_iter: usize,
+    tracking: bool,
 }
 
 /// Buffers of the decoder's value and gradients at one latent point.
@@ -112,6 +118,7 @@ impl Projection {
             low,
             high,
             max_iter: config.max_iter,
+            tracking: config.tracking,
         })
     }
 
@@ -221,6 +228,32 @@ impl Projection {
         if densest < best {
             z.copy_from_slice(&s.densest);
         }
+    }
+
+    /// Encodes `posture` reached after commanding the latent point `near`: in tracking mode
+    /// ([`ProjectionConfig::tracking`]) the reconstruction error `½‖x − μ(z)‖²` minimised from
+    /// `near` (clamped to the search box), so a tracked posture keeps its commanded point and
+    /// a disturbed one moves to the nearest latent point that reconstructs it, never to a far
+    /// demo's; otherwise [`Self::encode_into`]. Allocation-free, the same contract.
+    pub fn encode_near_into(&self, posture: &[f64], near: &[f64], z: &mut [f64], s: &mut ProjectionScratch) {
+        if !self.tracking {
+            return self.encode_into(posture, z, s);
+        }
+        debug_assert_eq!(near.len(), z.len());
+        for (k, v) in s.reconstructed.iter_mut().enumerate() {
+            *v = near[k].clamp(self.low[k], self.high[k]);
+        }
+        let decode = &mut s.decode;
+        let recon = |z: &[f64], g: &mut [f64]| self.reconstruction_error(z, posture, g, decode);
+        minimise(
+            recon,
+            &mut s.reconstructed,
+            &self.low,
+            &self.high,
+            self.max_iter,
+            &mut s.lbfgs,
+        );
+        z.copy_from_slice(&s.reconstructed);
     }
 
     /// `−log N(x | μ(z), σ²(z) I)` (Eq. 4's mean and variance), and its gradient with respect to
@@ -381,6 +414,34 @@ mod tests {
             let density =
                 |z: &[f64], s: &mut ProjectionScratch| p.neg_log_density(z, x.as_slice(), None, &mut s.decode);
             assert!(density(&z, &mut s) <= density(own.as_slice(), &mut s));
+        }
+    }
+
+    /// Tracking mode: a posture decoded at the commanded point encodes back to it exactly (the
+    /// search starts at a zero gradient), a slightly disturbed one stays near it, and without
+    /// tracking the same call is the nearest-demo projection.
+    #[test]
+    fn tracking_keeps_the_commanded_point() {
+        let (decoder, postures) = toy();
+        let tracking = ProjectionConfig {
+            tracking: true,
+            ..Default::default()
+        };
+        let p = Projection::new(&decoder, postures.clone(), tracking).unwrap();
+        let plain = Projection::new(&decoder, postures, ProjectionConfig::default()).unwrap();
+        let (mut s, mut x) = (p.scratch(), vec![0.0; 3]);
+        for z in [[0.2, 0.1], [-0.9, -0.4], [1.3, 0.6]] {
+            p.decoder.mean_into(&z, &mut x, &mut p.decoder.scratch());
+            let mut back = [9.0; 2];
+            p.encode_near_into(&x, &z, &mut back, &mut s);
+            assert!((back[0] - z[0]).hypot(back[1] - z[1]) < 1e-9, "{z:?} → {back:?}");
+            let nudged: Vec<f64> = x.iter().map(|v| v + 1e-3).collect();
+            p.encode_near_into(&nudged, &z, &mut back, &mut s);
+            assert!((back[0] - z[0]).hypot(back[1] - z[1]) < 0.05, "{z:?} → {back:?}");
+            let (mut a, mut b) = ([0.0; 2], [0.0; 2]);
+            plain.encode_near_into(&x, &z, &mut a, &mut s);
+            plain.encode_into(&x, &mut b, &mut s);
+            assert_eq!(a, b);
         }
     }
 

@@ -102,4 +102,14 @@ impl<'a> StateSpace<'a> {
             _ => z.copy_from_slice(posture),
         }
     }
+
+    /// Encodes `posture`, reached after commanding `near`, into `z` ([`Encode::encode_near_into`];
+    /// identity in the full space).
+    #[inline]
+    pub fn encode_near(&self, posture: &[f64], near: &[f64], z: &mut [f64], s: &mut SpaceScratch) {
+        match (self, s.encode.as_mut()) {
+            (StateSpace::Latent { encoder, .. }, Some(s)) => encoder.encode_near_into(posture, near, z, s),
+            _ => z.copy_from_slice(posture),
+        }
+    }
 }

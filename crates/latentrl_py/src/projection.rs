@@ -19,19 +19,25 @@ pub struct PyProjection {
 #[pymethods]
 impl PyProjection {
     /// The projection under `decoder` (a GpMap latent → posture) fitted to `postures` (N, D),
-    /// with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`.
+    /// with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`;
+    /// `tracking`: after a move, search from the commanded latent point (docs/encoders.md).
     #[new]
-    #[pyo3(signature = (decoder, postures, *, max_iter = 200, margin = 0.5))]
+    #[pyo3(signature = (decoder, postures, *, max_iter = 200, margin = 0.5, tracking = false))]
     fn new(
         py: Python<'_>,
         decoder: &Bound<'_, PyGpMap>,
         postures: PyReadonlyArray2<'_, f64>,
         max_iter: usize,
         margin: f64,
+        tracking: bool,
     ) -> PyResult<Self> {
         guard(|| {
             let postures = points("postures", &postures)?;
-            let config = ProjectionConfig { max_iter, margin };
+            let config = ProjectionConfig {
+                max_iter,
+                margin,
+                tracking,
+            };
             let decoder = &decoder.get().inner;
             let inner = py
                 .detach(|| Projection::new(decoder, postures, config))
