@@ -15,7 +15,7 @@ help: ## list the targets
 $(VENV)/.deps: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib "imageio>=2.31" "imageio-ffmpeg>=0.5" "moviepy>=2" "rerun-sdk>=0.23" tqdm gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm scikit-learn pandas "ray>=2.9" "pyarrow>=14" "h5py>=3.10" "rosbags>=0.10"
+	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib "imageio>=2.31" "imageio-ffmpeg>=0.5" "moviepy>=2" "rerun-sdk>=0.23" tqdm gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm "ruff>=0.17,<0.18" scikit-learn pandas "ray>=2.9" "pyarrow>=14" "h5py>=3.10" "rosbags>=0.10"
 	touch $@
 
 # The old extension is unlinked first: maturin would overwrite it in place, under the feet of a
@@ -72,9 +72,10 @@ figures: build ## the README's two GIFs: quick Exp 2 and Exp 3 runs into results
 	$(PY) -m latentrl replay results/exp2-quick --test 0 --out docs/figures/exp2-quick-pass.gif --width 640 --fps 10 --max-frames 100
 	$(PY) -m latentrl replay results/exp3-quick --test 2 --out docs/figures/exp3-quick-lift.gif --width 640 --fps 10 --max-frames 101
 
-lint: build ## rustfmt, clippy (warnings are errors), the native stubs against the module, mypy --strict
+lint: build ## rustfmt, clippy (warnings are errors), ruff, the native stubs against the module, mypy --strict
 	cargo fmt --all --check
 	cargo clippy --quiet --workspace --all-targets -- -D warnings
+	$(PY) -m ruff check python tests examples benches
 	$(PY) -m mypy.stubtest latentrl._native
 	$(PY) -m mypy --strict python/latentrl
 

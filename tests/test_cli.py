@@ -1,7 +1,6 @@
 """The `latentrl` command: help, info, runs, exit codes; results that do not depend on the
 thread count; runs interrupted (Ctrl-C) or killed mid-way and resumed to the uninterrupted result."""
 
-import dataclasses
 import json
 import os
 import signal

@@ -79,7 +79,7 @@ def test_quick_preset_ends_episodes_correctly(quick_run):
     # Measured 84-89 % per trial (Intel, seed 0, 6 trials): a floor well below, for episodes that neither
     # fall, drop nor touch the block; a plant that ended episodes at random would miss it.
     assert (ends == 0).mean() >= 0.4, "fewer than 40 % of episodes ran to the time-out"
-    for t, summary in meta["trials"]["latent"].items():
+    for summary in meta["trials"]["latent"].values():
         assert sum(summary["ends"].values()) == preset.episodes
 
 

@@ -10,8 +10,6 @@ reach rate of the last twelfth of training.
 """
 import sys
 
-import numpy as np
-
 from latentrl import GPLVM, train_latent_policy
 from latentrl.envs import shipped_demos
 from latentrl.experiments.exp3 import Exp3Preset

@@ -3,7 +3,8 @@
     python run_with_demos.py shipped|DEMOS.csv OUT quick|full [field=JSON ...]
     python run_with_demos.py shipped runs/m full trials=2 episodes=1500 test_episodes=100
 """
-import dataclasses, json, sys
+import json
+import sys
 from pathlib import Path
 import numpy as np
 from latentrl.experiments import exp3

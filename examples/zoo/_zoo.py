@@ -148,7 +148,7 @@ class Joint:
 
 
 def write_urdf(path: Path, name: str, comment: str, links: Sequence[Link], joints: Sequence[Joint]) -> None:
-    body = [f'<?xml version="1.0"?>', f"<!-- {comment.strip()}\n     Written by examples/zoo/make_urdfs.py. -->",
+    body = ['<?xml version="1.0"?>', f"<!-- {comment.strip()}\n     Written by examples/zoo/make_urdfs.py. -->",
             f'<robot name="{name}">']
     body += [link.xml() for link in links]
     body += [j.xml() for j in joints]

@@ -213,7 +213,7 @@ def save_figure(fig: Figure, out_dir: Path, name: str) -> list[Path]:
         buffer = io.BytesIO()
         fig.savefig(buffer, format=ext, dpi=150, bbox_inches="tight")
         path = Path(out_dir) / f"{name}.{ext}"
-        atomic_write(path, lambda f: f.write(buffer.getvalue()))
+        atomic_write(path, lambda f: f.write(buffer.getvalue()))  # noqa: B023 (called here)
         written.append(path)
     plt.close(fig)
     return written

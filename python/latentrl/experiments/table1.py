@@ -419,7 +419,7 @@ def _single_threaded_children() -> Iterator[None]:
     """Sets THREAD_VARIABLES to 1 while worker processes are spawned (they inherit the
     environment at start-up, before NumPy loads), then restores this process's values."""
     saved = {key: os.environ.get(key) for key in THREAD_VARIABLES}
-    os.environ.update({key: "1" for key in THREAD_VARIABLES})
+    os.environ.update(dict.fromkeys(THREAD_VARIABLES, "1"))
     try:
         yield
     finally:
