@@ -22,7 +22,9 @@ MAX_RECORDED_VALUES = 32 * 2**20
 brings into memory from one recording: 33 554 432, 256 MiB as float64 — 100 000 frames of 335
 joints, or 4.7 million frames of a 7-joint arm. Counted from metadata before anything is read.
 Past it, a recording is refused unless `max_postures` is given; then every k-th frame of each
-episode is read, k the smallest step that keeps the values read under the cap."""
+episode is read, k the smallest step that keeps the values read under the cap. The kept values
+are filled into one array an episode at a time; with the copy `Demonstrations` keeps, a read
+holds at most twice the cap (512 MiB) plus one episode as recorded."""
 
 REVOLUTE_BOUND = 2 * math.pi
 """A kept joint whose recorded values go beyond ±2π looks like degrees: refused without `degrees`."""
@@ -150,17 +152,21 @@ def read_frames(recording: Recording, *, expected_joints: Sequence[str] | None =
     columns = kept_columns(names, expected_joints, where)
     kept = tuple(names[c] for c in columns)
     step = frame_step(recording, max_postures)
-    blocks, episodes, frames = [], [], []
-    for episode in recording.episodes:
-        block = recording.read(episode, step)[:, columns]
-        _finite(block, kept, episode, step)
-        blocks.append(block)
-        episodes.append(np.full(len(block), episode.index, dtype=np.int64))
-        frames.append(np.arange(len(block), dtype=np.int64) * step)
-    values = np.concatenate(blocks)
-    episode_of, frame_of = np.concatenate(episodes), np.concatenate(frames)
+    counts = [math.ceil(e.frames / step) for e in recording.episodes]
+    values = np.empty((sum(counts), len(columns)))  # the kept values, filled an episode at a time
+    episode_of = np.repeat([e.index for e in recording.episodes], counts).astype(np.int64)
+    frame_of = np.concatenate([np.arange(n, dtype=np.int64) * step for n in counts])
+    start = 0
+    for episode, count in zip(recording.episodes, counts):
+        block = recording.read(episode, step)
+        if len(block) != count:
+            raise ValueError(f"{episode.where}: {len(block)} frames read where its metadata gives {count} "
+                             f"({episode.frames} frames, every {step}-th read)")
+        values[start:start + count] = block[:, columns]
+        _finite(values[start:start + count], kept, episode, step)
+        start += count
     if degrees:
-        values = np.radians(values)
+        np.radians(values, out=values)
     else:
         beyond = np.abs(values) > REVOLUTE_BOUND
         if beyond.any():
