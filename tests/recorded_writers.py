@@ -32,7 +32,7 @@ def episodes_of(lengths: tuple[int, ...] = (5, 7, 4), width: int = 3, seed: int 
     return [rng.uniform(-1.5, 1.5, size=(n, width)) for n in lengths]
 
 
-def write_lerobot(folder: Path, episodes: list[np.ndarray], names: list[str] | dict | None = list(NAMES), *,
+def write_lerobot(folder: Path, episodes: list[np.ndarray], names: tuple[str, ...] | list[str] | dict | None = NAMES, *,
                   key: str = "observation.state", value_type: pa.DataType = pa.float32(),
                   total_episodes: int | None = None) -> Path:
     """A LeRobot v2.1 dataset: meta/info.json and one parquet file per episode."""
