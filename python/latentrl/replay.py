@@ -6,6 +6,7 @@ path. GIF with Pillow, MP4 with the ffmpeg that imageio-ffmpeg ships: the `[vide
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from importlib import import_module
 from pathlib import Path
@@ -120,9 +121,15 @@ def robot_episode(task: Any, model: Any, low: NDArray[np.float64], high: NDArray
 
 
 def render_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_frames: int = 400) -> NDArray[np.uint8]:
-    """RGB frames (T, height, width, 3): the robot (or Exp 1's hands) at each stored step (left)
-    and V over the latent box with the latent path so far (right). What does not move is drawn
-    once; each frame restores it and draws the moving artists on it (matplotlib's blitting)."""
+    """RGB frames (T, height, width, 3) of `iter_frames`, all in memory."""
+    return np.stack(list(iter_frames(episode, size, max_frames)))
+
+
+def iter_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_frames: int = 400) -> Iterator[NDArray[np.uint8]]:
+    """RGB frames (height, width, 3), one at a time: the robot (or Exp 1's hands) at each stored
+    step (left) and V over the latent box with the latent path so far (right). What does not
+    move is drawn once; each frame restores it and draws the moving artists on it
+    (matplotlib's blitting)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -164,9 +171,7 @@ def render_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_fra
     canvas.draw()  # type: ignore[no-untyped-call]
     background = canvas.copy_from_bbox(fig.bbox)  # type: ignore[no-untyped-call]
     steps = len(episode.latent)
-    picks = np.unique(np.linspace(0, steps - 1, min(steps, max_frames)).round().astype(int))
-    frames = []
-    for step in picks:
+    for step in frame_steps(steps, max_frames):
         canvas.restore_region(background)  # type: ignore[no-untyped-call]
         move(step)
         label.set_text(f"step {step} of {steps - 1}")
@@ -174,20 +179,33 @@ def render_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_fra
         point.set_data([episode.latent[step, 0]], [episode.latent[step, 1]])
         for artist in moving:
             fig.draw_artist(artist)
-        frames.append(np.asarray(canvas.buffer_rgba())[..., :3].copy())  # type: ignore[no-untyped-call]
-    return np.stack(frames)
+        yield np.asarray(canvas.buffer_rgba())[..., :3].copy()  # type: ignore[no-untyped-call]
 
 
-def write_video(frames: NDArray[np.uint8], out: Path, fps: int) -> None:
-    """Writes `frames` to `out` (GIF or MP4 by suffix) through a temporary file, so a failed or
-    interrupted write leaves nothing half-written."""
-    import imageio.v3 as iio
+def frame_steps(steps: int, max_frames: int) -> NDArray[np.int64]:
+    """The stored steps drawn as frames: all `steps`, or `max_frames` of them evenly spread."""
+    return np.unique(np.linspace(0, steps - 1, min(steps, max_frames)).round().astype(np.int64))
 
+
+def write_video(frames: Iterable[NDArray[np.uint8]], out: Path, fps: int) -> None:
+    """Writes `frames` (at least one) to `out` (GIF or MP4 by suffix) as they come, through a
+    temporary file, so a failed or interrupted write leaves nothing half-written. Memory stays
+    bounded: an MP4's frames stream to ffmpeg (imageio's writer), a GIF keeps each frame
+    quantised to its 256-colour palette (Pillow, one byte per pixel) until it is saved."""
     with atomic_path(out) as temp:
         if out.suffix.lower() == ".gif":
-            iio.imwrite(temp, frames, duration=1000 / fps, loop=0)
-        else:
-            iio.imwrite(temp, frames, fps=fps)
+            from PIL import Image
+
+            images = (Image.fromarray(frame).quantize(256) for frame in frames)
+            first = next(images)  # Pillow takes the rest as they come
+            first.save(temp, format="GIF", save_all=True, append_images=images, duration=1000 / fps, loop=0)
+            return
+        import imageio.v2 as imageio
+
+        writer = imageio.get_writer(temp, format="FFMPEG", fps=fps)
+        with writer:  # streams each frame to ffmpeg's stdin
+            for frame in frames:
+                writer.append_data(frame)
 
 
 def run_setup(experiment: str, preset: Any, run_dir: Path) -> tuple[Any, Any, tuple[NDArray[np.float64], NDArray[np.float64]]]:
@@ -276,9 +294,8 @@ def render(drawn: Recorded, out: Path | None, rerun: Path | None, *, fps: int = 
     what was written."""
     done = []
     if out is not None:
-        frames = render_frames(drawn, size=(width, width // 2), max_frames=max_frames)
-        write_video(frames, out, fps)
-        done.append(f"{len(frames)} frames in {out}")
+        write_video(iter_frames(drawn, size=(width, width // 2), max_frames=max_frames), out, fps)
+        done.append(f"{len(frame_steps(len(drawn.latent), max_frames))} frames in {out}")
     if rerun is not None:
         from latentrl.rerun_log import write_rerun
 

@@ -1,6 +1,7 @@
 """A recorded episode as a Rerun recording (`latentrl replay --rerun FILE.rrd`, the `[viewer]`
 extra; view it with `rerun FILE.rrd`): on the timeline `step`, the robot's collision shapes as
-3-D solids (boxes, spheres, cylinders, capsules; a mesh link only by its sticks), the
+3-D solids (boxes, spheres, cylinders, capsules, and a mesh link as the convex hull the physics
+collides with), the
 kinematic tree, the effectors' paths so far, the obstacles, floor and target; and beside it the
 learnt V over the latent box (GPLVM variance shaded, as in the figures) as an image with the
 latent path on it. Exp 1's toy is drawn in its plane (z = 0)."""
@@ -50,6 +51,14 @@ def to_pixels(episode: Any, z: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.column_stack([unit[:, 0], 1 - unit[:, 1]]) * (VALUE_PIXELS - 1)
 
 
+def hull_mesh(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """The convex hull of `points` (K, 3) as vertices and triangles (indices into them)."""
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(points)
+    return points, np.asarray(hull.simplices, dtype=np.int64)
+
+
 def _log_static(rec: Any, episode: Any) -> None:
     """What does not move: obstacles, floor, target, the value map and the demos on it."""
     import rerun as rr
@@ -87,12 +96,20 @@ def _log_robot(rec: Any, episode: Any, step: int) -> None:
 
     scene = episode.scene
     pose_of = dict(zip(scene.link_names, episode.poses[step]))
-    solids: dict[str, list[Any]] = {"box": [], "sphere": [], "cylinder": [], "capsule": []}
+    solids: dict[str, list[Any]] = {"box": [], "sphere": [], "cylinder": [], "capsule": [], "mesh": []}
     for shape in scene.shapes:
         if shape["kind"] in solids and np.all(np.isfinite(pose_of[shape["link"]])):
             centre, rotation = shape_world_pose(pose_of[shape["link"]], shape)
-            solids[shape["kind"]].append((centre, rotation, np.asarray(shape["size"], dtype=np.float64)))
+            size = np.asarray(shape["points"] if shape["kind"] == "mesh" else shape["size"], dtype=np.float64)
+            solids[shape["kind"]].append((centre, rotation, size))
     blue = [60, 110, 200]
+    hulls = [hull_mesh(rotation.apply(points) + centre) for centre, rotation, points in solids["mesh"]
+             if len(points) >= 4]
+    if hulls:
+        offsets = np.cumsum([0] + [len(v) for v, _ in hulls[:-1]])
+        rec.log("world/robot/meshes", rr.Mesh3D(vertex_positions=np.vstack([v for v, _ in hulls]),
+                                                triangle_indices=np.vstack([t + o for (_, t), o in zip(hulls, offsets)]),
+                                                albedo_factor=blue))
     if solids["box"]:
         c, r, s = zip(*solids["box"])
         rec.log("world/robot/boxes", rr.Boxes3D(centers=c, half_sizes=[x / 2 for x in s],
