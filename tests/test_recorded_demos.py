@@ -68,6 +68,8 @@ def test_a_ros_bag_of_joint_states_loads_each_message_by_its_names(tmp_path, ros
     demos = load_demos(path, expected_joints=NAMES)
     np.testing.assert_array_equal(demos.postures, frames)
     assert demos.episodes.tolist() == [0] * 40 and demos.frames.tolist() == list(range(40))
+    with pytest.raises(ValueError, match=r"a bag's JointState messages name their joints; rename them with a joint map"):
+        load_demos(path, joint_names=NAMES)
 
 
 def test_joints_are_matched_by_name_extras_dropped_missing_refused(tmp_path):
