@@ -122,7 +122,8 @@ def test_settings_are_derived_where_the_task_is_silent(glass):
     task, demos, model = glass
     low, high = latent_box(model.Z_, 0.1)
     found = {d.key: d.value for d in derive(task, model, low, high, demos, set(task.given))}
-    assert found == {"learner.initial_weight": pytest.approx(100.0), "learner.step": 0.5}  # max_steps: the file's
+    assert found == {"learner.initial_weight": pytest.approx(100.0), "learner.step": 0.5,  # max_steps: the file's
+                     "episode.stop_window": 100}
     tight = task.replace({"target.reach_radius": 0.01})
     assert {d.key: d.value for d in derive(tight, model, low, high, demos, set(tight.given))}["learner.step"] < 0.5
     written = tomllib.loads((EXAMPLE / "glass_arm.toml").read_text())
@@ -132,4 +133,5 @@ def test_settings_are_derived_where_the_task_is_silent(glass):
     derived = {d.key: d for d in derive(silent, model, low, high, demos, set(silent.given))}
     assert derived["learner.initial_weight"].value == pytest.approx(1 / (1 - 0.95))
     assert 50 <= derived["episode.max_steps"].value <= 1000 and "moves" in derived["episode.max_steps"].rule
-    assert derive(task, model, low, high, demos, set(task.given) | {"learner.step", "learner.initial_weight"}) == []
+    assert derive(task, model, low, high, demos,
+                  set(task.given) | {"learner.step", "learner.initial_weight", "episode.stop_window"}) == []

@@ -83,7 +83,7 @@ def test_the_readme_commands_train_save_and_roll_out(runs):
     meta = json.loads((runs["learner"] / "results.json").read_text())
     assert meta["preset"]["name"] == "TrainRun" and meta["setup"]["task"]["name"] == "glass_arm"
     derived = {d["key"]: d["value"] for d in meta["setup"]["derived"]}
-    assert derived == {"learner.initial_weight": pytest.approx(100.0), "learner.step": 0.5}
+    assert derived == {"learner.initial_weight": pytest.approx(100.0), "learner.step": 0.5, "episode.stop_window": 100}
     assert meta["setup"]["task"]["learner"]["step"] == 0.5
     assert (runs["learner"] / "policy.npz").is_file() and (runs["learner"] / "returns.png").is_file()
 

@@ -181,3 +181,21 @@ def test_bad_models() -> None:
     three = GPLVM(n_components=3, max_iter=5).fit(X)
     policy = train_latent_policy(three, trials=1, episodes=2, overrides={"episode.max_steps": 5}, test_episodes=0)
     assert policy.weights.shape == (1, 20**3), "a 3-D latent space: a 20³ grid"
+
+
+def test_a_trial_that_stopped_improving_stops_and_is_read_as_it_ran(arms_model: GPLVM) -> None:
+    """Issue #37: under `episode.stop_window` a trial ends once it stopped improving; its arrays
+    hold NaN returns and end −1 after; end counts and the verdict count the episodes it ran."""
+    from latentrl.verdict import training_verdict
+
+    task = Task.from_dict({**Task.shipped("two_arms").to_dict(), "name": "mine"}, Task.shipped("two_arms").base_dir)
+    policy = train_latent_policy(arms_model, task, trials=2, episodes=400, test_episodes=1,
+                                 overrides={"episode.max_steps": 10, "episode.stop_window": 10,
+                                            "episode.stop_patience": 1})
+    ran = (policy.record["ends"] >= 0).sum(axis=1)
+    assert (ran < 400).all() and (ran % 10 == 0).all()
+    assert np.isnan(policy.returns[0, ran[0]:]).all() and np.isfinite(policy.returns[0, :ran[0]]).all()
+    assert sum(policy.end_counts().values()) == ran.sum()
+    assert sum(policy.end_counts(last=5).values()) == 2 * 5
+    verdict = training_verdict(policy, episodes=2)
+    assert sum(verdict.late_ends.values()) == sum(max(1, int(ran.min()) // 5) for _ in ran)

@@ -12,7 +12,10 @@ The rules (docs/tasks.md, "Settings derived from the data"):
   (admissible latent points within `target.reach_radius`, `latentrl check`'s survey) spans at
   least `SPAN` steps across, so a move can land inside it and stay;
 - `episode.max_steps` = `SLACK` × the moves that 95 % of admissible starts need to the target at
-  that step (at least `MIN_STEPS`, at most the schema's default).
+  that step (at least `MIN_STEPS`, at most the schema's default);
+- `episode.stop_window` = `STOP_WINDOW`: a trial stops once 3 windows of that many episodes in a
+  row raised neither its reach count nor its mean return by 1 % (`latent_core::stopping`), so
+  the episode budget is a ceiling.
 """
 
 from __future__ import annotations
@@ -37,6 +40,10 @@ SLACK = 3
 
 MIN_STEPS = 50
 """The shortest derived episode."""
+
+STOP_WINDOW = 100
+"""Episodes per window of the stopping rule: a window's reach count moves by whole episodes, so
+a window of 100 sees a 1 % change of the reach rate."""
 
 
 @dataclass(frozen=True)
@@ -83,6 +90,10 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
             value = int(min(default, max(MIN_STEPS, SLACK * needed)))
             out.append(Derived("episode.max_steps", value, f"{SLACK} × the {needed} moves 95 % of admissible starts "
                                                            f"need to the target at rest (in [{MIN_STEPS}, {default}])"))
+    if "episode.stop_window" not in given:
+        out.append(Derived("episode.stop_window", STOP_WINDOW,
+                           f"stop a trial after {config['episode']['stop_patience']} windows of {STOP_WINDOW} episodes "
+                           "in a row without a higher reach count or a mean return 1 % higher (the budget is a ceiling)"))
     return out
 
 

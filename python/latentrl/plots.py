@@ -4,6 +4,7 @@ over a latent space, saved as PNG + PDF."""
 from __future__ import annotations
 
 import io
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -34,10 +35,16 @@ def running_mean(values: NDArray[np.float64], window: int) -> NDArray[np.float64
 
 
 def learning_curves(ax: Axes, returns: Mapping[str, NDArray[np.float64]], window: int = 1) -> None:
-    """Mean ± s.d. over trials of the (running-averaged) return per episode, one line per learner."""
+    """Mean ± s.d. over trials of the (running-averaged) return per episode, one line per learner;
+    a trial the stopping rule ended (NaN returns after) counts until it stopped."""
     for name, per_trial in returns.items():
         smooth = running_mean(np.asarray(per_trial, dtype=float), window)
-        mean, std = smooth.mean(axis=0), smooth.std(axis=0)
+        if np.isnan(smooth).any():
+            with warnings.catch_warnings():  # episodes no trial ran are NaN, as they should be
+                warnings.simplefilter("ignore", RuntimeWarning)
+                mean, std = np.nanmean(smooth, axis=0), np.nanstd(smooth, axis=0)
+        else:
+            mean, std = smooth.mean(axis=0), smooth.std(axis=0)
         episodes = np.arange(1, mean.size + 1)
         (line,) = ax.plot(episodes, mean, label=name)
         ax.fill_between(episodes, mean - std, mean + std, color=line.get_color(), alpha=0.25, lw=0)

@@ -1,5 +1,5 @@
-"""Train a latent-space TD(0) policy (SPEC §3.1) on any task from your own fitted GPLVM, save
-it, load it and run it.
+"""Train a latent-space TD(0) policy (docs/method.md §RL loop) on any task from your own fitted
+GPLVM, save it, load it and run it.
 
     task = Task.load("my_robot.toml")
     policy = train_latent_policy(model, task, demos=postures, trials=2, episodes=300)
@@ -247,8 +247,9 @@ class LatentPolicy:
         return int(trial)
 
     def end_counts(self, last: int | None = None) -> dict[str, int]:
-        """How many of the (`last`) training episodes of all trials ended each way."""
-        ends = self.record["ends"] if last is None else self.record["ends"][:, -last:]
+        """How many of the (`last`) training episodes each trial ran ended each way."""
+        run = [row[row >= 0] for row in np.asarray(self.record["ends"])]  # −1: after a trial stopped
+        ends = np.concatenate([row if last is None else row[-last:] for row in run])
         names = end_reasons()
         return {names[int(c)]: int(n) for c, n in zip(*np.unique(ends, return_counts=True))}
 

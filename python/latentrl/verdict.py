@@ -11,7 +11,7 @@ such a rule, that comes within the reach radius at some step. One of three verdi
 - **never reached it**: no training episode came within the reach radius;
 - **stopped improving below the target**: anything between.
 
-With the verdict come the endings of the last fifth of the training episodes, whether the reach
+With the verdict come the endings of the last fifth of the training episodes each trial ran, whether the reach
 rate was still rising there (more episodes may help), and the next things to try, taken from the
 endings and from `latentrl check`'s findings.
 """
@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from latentrl.experiments.runner import end_counts
 from latentrl.task import end_reasons
@@ -84,10 +85,16 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
     control = success_share(rollouts["random"])
     reached = np.asarray(policy.record["reached"], dtype=bool)
     ends = np.asarray(policy.record["ends"])
-    n = reached.shape[1]
+    runs = (ends >= 0).sum(axis=1)  # a trial the stopping rule ended ran fewer (ends −1 after)
+    n = int(runs.min())
     fifth, tenth = max(1, n // 5), max(1, n // 10)
-    reach_late = float(reached[:, -fifth:].mean())
-    rising = n >= 20 and reached[:, -tenth:].mean() > reached[:, -2 * tenth:-tenth].mean() + RISING
+
+    def last(values: NDArray[Any], k: int, skip: int = 0) -> NDArray[Any]:
+        """The `k` episodes of every trial before its last `skip` run, pooled."""
+        return np.concatenate([row[r - skip - k:r - skip] for row, r in zip(values, runs)])
+
+    reach_late = float(last(reached, fifth).mean())
+    rising = n >= 20 and last(reached, tenth).mean() > last(reached, tenth, tenth).mean() + RISING
     if best >= LEARNT and best > control:
         verdict = "learnt"
     elif not reached.any():
@@ -95,11 +102,11 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
     else:
         verdict = "stopped improving below the target"
     names = end_reasons()
-    late = ends[:, -fifth:]
+    late = last(ends, fifth)
     late_ends = end_counts(late)
     steps: list[str] = []
     if verdict != "learnt":
-        failing = late[~reached[:, -fifth:]]
+        failing = late[~last(reached, fifth)]
         if failing.size:
             worst = names[int(np.bincount(failing, minlength=len(names)).argmax())]
             if worst in ADVICE:

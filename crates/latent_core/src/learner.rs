@@ -1,8 +1,8 @@
-//! The TD(0) learner of RL in a latent space (paper Sec. III-D/E, SPEC §3): an RBF grid over
-//! the state box, the value weights, the soft-max policy and the scaled action set.
+//! The TD(0) learner of RL in a latent space (paper Sec. III-D/E; docs/method.md §TD(0)): an RBF
+//! grid over the state box, the value weights, the soft-max policy and the scaled action set.
 //!
 //! The step displacement is `Δ_i = step · h ⊙ u_i`: each action's unit direction `u_i`
-//! scaled per dimension by the RBF grid spacing `h` (SPEC: 0.2 × spacing).
+//! scaled per dimension by the RBF grid spacing `h` (ours: 0.2 × spacing, docs/method.md §Policy).
 
 use crate::config::LearnerConfig;
 use crate::error::Result;
@@ -35,6 +35,9 @@ pub struct EpisodeRules {
     pub start: StartMode,
     /// Draws allowed to find an admissible start before [`crate::CoreError::NoValidStart`].
     pub max_start_draws: usize,
+    /// Stop a training trial once it has stopped improving ([`crate::stopping`]); `None`: run
+    /// every episode (the paper's).
+    pub stop: Option<crate::StopRule>,
 }
 
 impl Default for EpisodeRules {
@@ -44,6 +47,7 @@ impl Default for EpisodeRules {
             penalty: -1.0,
             start: StartMode::Plant,
             max_start_draws: 1000,
+            stop: None,
         }
     }
 }
@@ -69,7 +73,8 @@ pub enum Phase {
     #[default]
     Train,
     /// No updates: the soft-max policy acts on the learnt value function as it is, and
-    /// starts must also pass [`crate::Plant::admits_test_start`] (SPEC §4.2's frozen tests).
+    /// starts must also pass [`crate::Plant::admits_test_start`] (Experiment 2's frozen tests,
+    /// docs/method.md §Experiment 2).
     Test,
     /// No updates, actions by `action`; starts as the frozen tests' (`test_starts`) or as
     /// training's. What a saved policy does when it is run, and its control.

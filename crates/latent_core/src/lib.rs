@@ -19,6 +19,7 @@ pub mod policy;
 pub mod projection;
 pub mod rbf;
 pub mod space;
+pub mod stopping;
 pub mod td;
 pub mod trials;
 
@@ -36,5 +37,6 @@ pub use policy::SoftmaxPolicy;
 pub use projection::{Projection, ProjectionConfig, ProjectionScratch};
 pub use rbf::{RbfConfig, RbfGrid, SparseFeatures};
 pub use space::StateSpace;
+pub use stopping::{Plateau, StopRule};
 pub use td::TdLearner;
 pub use trials::{TrialOptions, TrialResult, run_trials, trial_rng};

@@ -1,5 +1,5 @@
-//! Independent trials in parallel (SPEC §4: "25 trials"), deterministic whatever the
-//! thread count.
+//! Independent trials in parallel (the paper's "25 trials", docs/method.md §Experiments),
+//! deterministic whatever the thread count.
 //!
 //! Trial `i` draws every random number (start states, soft-max draws) from its own
 //! generator [`trial_rng`]`(base_seed, i)`: a ChaCha8 generator keyed by `base_seed` on
@@ -10,8 +10,8 @@
 //!
 //! After its training episodes a trial may run `test_episodes` frozen test episodes
 //! ([`Phase::Test`]: no TD updates, starts filtered by [`crate::Plant::admits_test_start`])
-//! with the same generator, e.g. SPEC §4.2's "50 frozen test episodes from starts below
-//! the wall".
+//! with the same generator, e.g. Experiment 2's 50 frozen test episodes from starts below
+//! the wall (docs/method.md §Experiment 2).
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -136,7 +136,8 @@ impl TrialOptions {
 pub struct TrialResult {
     /// The trial index (the generator's stream).
     pub trial: usize,
-    /// One record per episode run, in order (fewer than `episodes` if cancelled).
+    /// One record per episode run, in order (fewer than `episodes` if cancelled, or stopped by
+    /// the learner's [`crate::EpisodeRules::stop`] rule: then `finished` all the same).
     pub episodes: Vec<EpisodeRecord>,
     /// One task-space trajectory per entry of `record_episodes` (rows of `task_dim`
     /// values: the start, then one per plant step); empty if that episode was not run.
@@ -318,6 +319,12 @@ impl<P: Plant> TrialRun<'_, P> {
         let mut trajectories = vec![Vec::new(); record.len()];
         let mut buffer = Vec::new();
         let task_dim = self.plant.task_dim();
+        let stop = self
+            .learner
+            .rules()
+            .stop
+            .filter(|_| self.learner.phase() == Phase::Train);
+        let mut plateau = stop.map(crate::Plateau::new);
         for e in 0..n {
             if self.cancel.load(Ordering::Relaxed) {
                 return Ok((episodes, trajectories, false));
@@ -345,8 +352,13 @@ impl<P: Plant> TrialRun<'_, P> {
                     slot.clone_from(&buffer);
                 }
             }
+            let stopped = plateau.as_mut().is_some_and(|p| p.record(&rec));
             episodes.push(rec);
             self.done.fetch_add(1, Ordering::Relaxed);
+            if stopped {
+                self.done.fetch_add(n - e - 1, Ordering::Relaxed); // progress counts the skipped ones
+                break;
+            }
         }
         Ok((episodes, trajectories, true))
     }
@@ -451,6 +463,44 @@ mod tests {
         let tested = run(ActionRule::Random, true, 4);
         assert!(starts(&tested).iter().all(|&x| x < 0.5));
         assert!(starts(&greedy).iter().any(|&x| x >= 0.5));
+    }
+
+    /// A trial under a stopping rule ends early, finished, its test episodes run, and progress
+    /// counts the skipped episodes; without the rule it runs every episode.
+    #[test]
+    fn a_stopping_rule_ends_a_flat_trial_early() {
+        let config = crate::LearnerConfig {
+            rbf_per_dim: 11,
+            step: 1.0,
+            ..Default::default()
+        };
+        let run = |stop| {
+            let rules = crate::EpisodeRules {
+                max_steps: 5,
+                stop,
+                ..Default::default()
+            };
+            let template = Learner::new(&config, rules, &[0.0], &[1.0]).unwrap();
+            let options = TrialOptions {
+                episodes: 2000,
+                test_episodes: 3,
+                ..Default::default()
+            };
+            let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
+            let plant = |_| Ok(Line { x: 0.0 });
+            let trial = run_trials(&template, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
+            assert_eq!(done.load(Ordering::Relaxed), 2003);
+            trial.into_iter().next().unwrap()
+        };
+        let full = run(None);
+        assert_eq!((full.episodes.len(), full.finished), (2000, true));
+        let stopped = run(Some(crate::StopRule {
+            window: 20,
+            patience: 2,
+        }));
+        assert!(stopped.finished && stopped.tests.len() == 3);
+        assert!(stopped.episodes.len() < 2000 && stopped.episodes.len() % 20 == 0);
+        assert_eq!(stopped.episodes[..], full.episodes[..stopped.episodes.len()]);
     }
 
     #[test]

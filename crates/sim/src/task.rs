@@ -159,6 +159,10 @@ impl Task {
                 crate::task::StartRule::Demo => StartMode::Plant,
             },
             max_start_draws: e.max_start_draws,
+            stop: (e.stop_window > 0).then_some(latent_core::StopRule {
+                window: e.stop_window,
+                patience: e.stop_patience,
+            }),
         }
     }
 

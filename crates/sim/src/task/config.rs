@@ -85,7 +85,8 @@ choice! {
 choice! {
     /// When a step tests the rules that end an episode (obstacles, falls, constraints).
     pub enum RuleCheck {
-        /// Once, after the RL step's last physics step (SPEC: the reached state).
+        /// Once, after the RL step's last physics step (docs/method.md §RL loop: the reached
+        /// state).
         RlStep = "rl_step",
         /// After every physics step of the RL step: a touch in between ends it too (the
         /// RL step still runs all its physics steps).
@@ -316,9 +317,10 @@ params! {
         /// The links allowed to touch the floor; the first stands flat at a reset (box
         /// collision shapes make the support polygon).
         soles: Vec<String> = Vec::new() => Rule::NonEmpty,
-        /// A sole leaning more than this from the vertical is a fall (rad; SPEC: 20°).
+        /// A sole leaning more than this from the vertical is a fall (rad; Experiment 3: 20°).
         max_tilt: f64 = 20f64.to_radians() => Rule::open_closed(0.0, std::f64::consts::PI),
-        /// The base below this share of its height above the floor at the reset is a fall (SPEC: half).
+        /// The base below this share of its height above the floor at the reset is a fall
+        /// (Experiment 3: half).
         base_height_fraction: f64 = 0.5 => Rule::open(0.0, 1.0),
         /// A start is refused unless the centre of mass lies at least this far (m) inside the
         /// support polygon (negative: outside allowed).
@@ -344,6 +346,13 @@ params! {
         start_noise: f64 = 0.0 => Rule::closed(0.0, 10.0),
         /// Draws allowed to find an admissible start.
         max_start_draws: usize = 1000 => Rule::count(1, 1_000_000_000),
+        /// Ours, not the paper's: stop a training trial once `stop_patience` windows of this many
+        /// episodes in a row raised neither its reach count nor its mean return by 1 % (the
+        /// episode budget is then a ceiling; `latentrl train` derives it where silent); 0: run
+        /// every episode (the paper's).
+        stop_window: usize = 0 => Rule::count(0, 1_000_000_000),
+        /// Windows without improvement before a trial stops (with `stop_window`).
+        stop_patience: usize = 3 => Rule::count(1, 1_000_000),
         /// Which admissible starts may start a frozen test episode: "any" or "below_waypoint".
         test_start: TestStart = TestStart::Any => Rule::Any,
         /// When a step tests the end rules: "rl_step" (once, at its end) or "physics_step"
