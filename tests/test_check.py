@@ -51,6 +51,10 @@ def test_an_encoder_whose_round_trip_jumps_is_named():
     demos = task.demo_postures(loaded.joint_names, loaded.postures, "demos")
     found = next(f for f in check(task, demos).findings if f.name == "encoder")
     assert found.verdict == "warning" and found.values["median_steps"] > 10 and "back_constrained" in found.fix
+    assert "--encoder tracking" in found.fix
+    tracking = GPLVM(n_components=2, max_iter=50, random_state=0, encoder="tracking").fit(demos)
+    found = next(f for f in check(task, demos, tracking).findings if f.name == "encoder")
+    assert found.verdict == "ok" and found.values["median_steps"] == 0.0
 
 
 def test_a_target_outside_the_decodable_region_will_not_learn(glass):

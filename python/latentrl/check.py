@@ -270,6 +270,9 @@ def encoder_finding(model: Any, survey: dict[str, Any]) -> Finding:
     admissible = survey["codes"] == 0
     if not admissible.any():
         return Finding("encoder", "ok", "no admissible point to measure")
+    if getattr(model, "encoder", None) == "tracking":
+        return Finding("encoder", "ok", "the tracking encoder keeps the commanded point of a tracked move "
+                       "(0 learner steps by construction)", None, {"median_steps": 0.0, "p90_steps": 0.0})
     points = survey["points"][admissible]
     back = model.transform(model.inverse_transform(points))
     step = float(np.min(survey["spacing"]) / survey["stride"])
@@ -281,7 +284,8 @@ def encoder_finding(model: Any, survey: dict[str, Any]) -> Finding:
     if median <= ROUND_TRIP:
         return Finding("encoder", "ok", message, None, values)
     return Finding("encoder", "warning", message + ": the learner's state jumps after its moves",
-                   "--encoder back_constrained (encodes the demos exactly), or a converged fit", values)
+                   "--encoder tracking (a tracked move keeps its commanded point) or --encoder back_constrained "
+                   "(encodes the demos exactly; on the zoo each helped a different robot), or a converged fit", values)
 
 
 def servo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
