@@ -618,7 +618,7 @@ def main(argv: list[str] | None = None) -> int:
         "--out", type=Path, default=Path(__file__).resolve().parent / "results" / "bench_gp.json"
     )
     parser.add_argument("--quick", action="store_true", help="one fit repeat (smoke run)")
-    parser.add_argument("--blas-threads", type=int, default=1, help="BLAS threads (PEERS.md: 1)")
+    parser.add_argument("--blas-threads", type=int, default=1, help="BLAS threads (peer figures: 1)")
     parser.add_argument(
         "--fit-seeds", type=int, default=5, help="data sets for the fit NLL comparison"
     )

@@ -1,5 +1,6 @@
 """Gymnasium environments: the env checker on every registered id and on the latent wrapper,
-episode endings as SPEC §4 specifies, determinism given a seed, rendering."""
+episode endings as docs/method.md §Reward and endings specifies, determinism given a seed,
+rendering."""
 
 import gymnasium as gym
 import numpy as np

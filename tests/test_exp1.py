@@ -1,4 +1,5 @@
-"""Experiment 1 end to end: the quick preset learns, results follow SPEC §5, runs resume."""
+"""Experiment 1 end to end: the quick preset learns, results follow docs/method.md §Results layout,
+runs resume."""
 
 import dataclasses
 import json
@@ -34,8 +35,8 @@ def test_quick_preset_latent_learner_learns_and_never_drops(quick_run, control_r
     """The latent learner's mean return of the last 50 episodes lies above 150 and above 2.5 ×
     that of its first 50, the control's (α = 1e-12, same trials) below both. Calibrated on 10
     trials of seed 0 (AMD EPYC, `latentrl sweep`, grid alpha = [0.9, 1e-12]): last 50 learner
-    219.9–259.8, control 4.9–11.5; last/first learner 2.8–3.9, control 0.5–1.4 (SPEC §4.1's
-    NumPy study: 3.0–3.5, 223–266)."""
+    219.9–259.8, control 4.9–11.5; last/first learner 2.8–3.9, control 0.5–1.4 (the design
+    study of docs/method.md §Experiment 1: 3.0–3.5, 223–266)."""
     late, ratio = {}, {}
     for name, out in (("learner", quick_run[0]), ("control", control_run)):
         with np.load(out / "returns.npz") as npz:

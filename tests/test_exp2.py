@@ -1,5 +1,6 @@
 """Experiment 2 end to end: the native arms runner's checks and records, the quick preset's
-learning (SPEC §4.2 assertions), the SPEC §5 layout with per-trial test results, resumes."""
+learning (the thresholds of docs/method.md §Experiment 2), the results layout with per-trial test
+results, resumes."""
 
 import dataclasses
 import json
@@ -135,15 +136,15 @@ def control_run(tmp_path_factory):
 
 
 def test_quick_preset_passes_the_corridor_and_reaches_the_target(quick_run, control_run):
-    """SPEC §4.2's quick-preset thresholds, each met by the learner and missed by the control
-    (α = 1e-12) on the same trials: return of episodes 251–300 ≥ 600, test success ≥ 60 %,
-    corridor passed in ≥ 60 % of the tests, corridor endings in episodes 201–300 ≤ 20 %.
-    Calibrated on 10 trials of seed 0 (AMD EPYC, `latentrl sweep`, grid alpha = [0.8, 1e-12]):
-    late return learner 820–916, control 21–47; test success 0.84–0.96 vs 0–0.04; corridor
-    endings in the last 50 episodes 0–6 % vs 38–52 % (dt 1/240 physics; with the shipped
-    1/120 × 6, 2 × 4 since 2026-12-03 the preset's 3 trials give late return 877–933, test
-    success 0.84–0.94, corridor endings 2–3 %). SPEC's return ratio ≥ 1.4 is not asserted:
-    the control reaches 1.9 (its returns are small and noisy)."""
+    """The quick-preset thresholds of docs/method.md §Experiment 2, each met by the learner and
+    missed by the control (α = 1e-12) on the same trials: return of episodes 251–300 ≥ 600, test
+    success ≥ 60 %, corridor passed in ≥ 60 % of the tests, corridor endings in episodes 201–300
+    ≤ 20 %. Calibrated on 10 trials of seed 0 (AMD EPYC, `latentrl sweep`, grid
+    alpha = [0.8, 1e-12]): late return learner 820–916, control 21–47; test success 0.84–0.96 vs
+    0–0.04; corridor endings in the last 50 episodes 0–6 % vs 38–52 % (dt 1/240 physics; with the
+    shipped 1/120 × 6, 2 × 4 since 2026-12-03 the preset's 3 trials give late return 877–933,
+    test success 0.84–0.94, corridor endings 2–3 %). Its return ratio ≥ 1.4 is not asserted: the
+    control reaches 1.9 (its returns are small and noisy)."""
     out, meta = quick_run
     arrays = {}
     for name, where in (("learner", out), ("control", control_run)):

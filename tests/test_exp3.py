@@ -1,6 +1,6 @@
 """Experiment 3 end to end: the native humanoid runner's checks and records, the quick preset
-(finite returns, end codes, the SPEC §5 layout and figure names), same seed same results,
-resumes, and the CLI."""
+(finite returns, end codes, the results layout (docs/method.md) and figure names), same seed same
+results, resumes, and the CLI."""
 
 import dataclasses
 import json

@@ -1,4 +1,5 @@
-"""The KHR-1HV-like humanoid, its lift demos and the PCA/GPLVM fall check (SPEC §4.3)."""
+"""The KHR-1HV-like humanoid, its lift demos and the PCA/GPLVM fall check
+(docs/method.md §Experiment 3)."""
 
 import numpy as np
 import pytest
@@ -107,7 +108,8 @@ def test_table_has_every_method_pose_and_line(table):
 
 
 def test_gplvm_keeps_grip_and_margin_of_the_demos(table):
-    """SPEC §4.3 acceptance: the GPLVM keeps grip and margin within 1 mm of the demos."""
+    """The acceptance of docs/method.md §Experiment 3: the GPLVM keeps grip and margin within 1 mm
+    of the demos."""
     demo = {r["segment"]: r for r in table if r["method"] == "joint"}
     demo_margin = min(r["margin"] for s, r in demo.items() if s.startswith("pose"))
     for r in (r for r in table if r["method"] == "GPLVM"):

@@ -239,7 +239,8 @@ def run_bimanual_trials(
     return_weights: bool = False,
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
-    """Runs Experiment 1 (SPEC §4.1) trials in parallel in Rust and returns their records."""
+    """Runs Experiment 1 (docs/method.md §Experiment 1) trials in parallel in Rust and returns their
+    records."""
 
 def bimanual_config(
     plant: Mapping[str, object] | None = None, learner: Mapping[str, object] | None = None

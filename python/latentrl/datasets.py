@@ -1,6 +1,7 @@
-"""Demonstration generators for the bimanual task (SPEC §4.1, §4.2): postures that satisfy the
-constraint "the right hand is 0.1 m to the right of the left hand", plus a NumPy forward
-kinematics of the two planar arms (the reference the Rust `arms_fk` is tested against).
+"""Demonstration generators for the bimanual task (docs/method.md §Experiment 1, §Experiment 2):
+postures that satisfy the constraint "the right hand is 0.1 m to the right of the left hand", plus a
+NumPy forward kinematics of the two planar arms (the reference the Rust `arms_fk` is tested
+against).
 
 Every generator takes a seeded `numpy.random.Generator` and is deterministic given it.
 
@@ -27,13 +28,14 @@ from latentrl._native import arms_ik
 from latentrl._validation import as_matrix, int_at_least
 
 OFFSET = np.array([0.1, 0.0])
-"""The constraint: hand_R − hand_L (metres), SPEC §4.1."""
+"""The constraint: hand_R − hand_L (metres), docs/method.md §Experiment 1."""
 
 SHOULDERS = np.array([[-0.15, 0.0], [0.15, 0.0]])
-"""Left and right shoulder (x, y) in metres (ours; SPEC §4.2 table). Mirrors `sim::PlanarArms`."""
+"""Left and right shoulder (x, y) in metres (ours; docs/method.md §Experiment 2). Mirrors
+`sim::PlanarArms`."""
 
 LINKS = (0.3, 0.3)
-"""Upper arm and forearm lengths in metres (ours; SPEC §4.2 table)."""
+"""Upper arm and forearm lengths in metres (ours; docs/method.md §Experiment 2)."""
 
 EE_LEFT_BOX = ((-0.5, -0.5), (1.4, 1.5))
 """Default region of the left hand for end-effector demos: ((x_min, y_min), (x_max, y_max))."""
@@ -66,7 +68,7 @@ def bimanual_pairs(
 
     The left hand is uniform over `left_box`; `noise` > 0 adds independent Gaussian noise of
     that standard deviation (metres) to every coordinate afterwards (a "slightly noisy"
-    demonstrator, SPEC §4.2).
+    demonstrator, docs/method.md §Table I).
     """
     n = int_at_least("n", n)
     noise = _check_noise(noise)
@@ -164,8 +166,8 @@ def grip_error(
     """How far each hand pair (N, 4) is from holding the object, in metres.
 
     `"distance"`: `| ‖hand_R − hand_L‖ − 0.1 |` (the paper's Fig. 5: "distance between the
-    end-effectors within 0.005 of 0.1"); `"vector"`: `‖(hand_R − hand_L) − (0.1, 0)‖` (SPEC §4.1's
-    drop test, which also catches a rotated object).
+    end-effectors within 0.005 of 0.1"); `"vector"`: `‖(hand_R − hand_L) − (0.1, 0)‖`
+    (Experiment 1's drop test, docs/method.md §Experiment 1, which also catches a rotated object).
     """
     hands = as_matrix("hands", hands, n_cols=4)
     diff = hands[:, 2:] - hands[:, :2]

@@ -7,8 +7,8 @@
 - `latentrl/BimanualReach-v0` (`BimanualReachEnv`): Experiment 1's kinematic toy over the native
   toy plant.
 - `LatentSpaceWrapper`: observations and actions in the latent space of a fitted `PCA` or
-  `GPLVM` (SPEC §3.1): an action is a latent delta, the target latent point is decoded to a
-  posture target, and the reached posture is encoded back.
+  `GPLVM` (docs/method.md §RL loop): an action is a latent delta, the target latent point is decoded
+  to a posture target, and the reached posture is encoded back.
 
 Every environment exposes `posture` (the current posture, (D,)) so the wrapper can encode it,
 and `action_origin`, what an action (a delta, clipped to the action space) is added to.
@@ -203,8 +203,9 @@ class TaskEnv(gym.Env[Obs, Obs]):
 
 
 class BimanualReachEnv(gym.Env[Obs, Obs]):
-    """Two planar hands carrying an object to a target (paper Sec. IV-A, SPEC §4.1), over the
-    native toy plant of Experiment 1 (its rules and defaults: `latentrl run exp1 --help`).
+    """Two planar hands carrying an object to a target (paper Sec. IV-A,
+    docs/method.md §Experiment 1), over the native toy plant of Experiment 1 (its rules and
+    defaults: `latentrl run exp1 --help`).
 
     ## Action Space
     `Box(-max_step, max_step, (4,), float64)`: deltas of the hand targets
@@ -229,8 +230,8 @@ class BimanualReachEnv(gym.Env[Obs, Obs]):
     (`"drop"`); `info["end_reason"]` says which. Truncated after 500 steps (the paper's).
 
     ## Arguments
-    `drop_tolerance` (0.1: SPEC's RL default; 0.005 the paper-strict variant), `max_step`
-    (0.05 m per coordinate), `render_mode` (`None` or `"rgb_array"`).
+    `drop_tolerance` (0.1: our RL default, docs/method.md §Experiment 1; 0.005 the paper-strict
+    variant), `max_step` (0.05 m per coordinate), `render_mode` (`None` or `"rgb_array"`).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
@@ -287,19 +288,20 @@ class BimanualReachEnv(gym.Env[Obs, Obs]):
 
 
 class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstructorArgs):
-    """RL in the latent space of a fitted `PCA` or `GPLVM` (SPEC §3.1, Fig. 3).
+    """RL in the latent space of a fitted `PCA` or `GPLVM` (docs/method.md §RL loop, paper Fig. 3).
 
     The observation is the encoded reached posture `z = g(x̃)` (`model.transform`), clipped
     into the latent box. An action is a latent delta `u` (clipped to the action space); the
     target `z + u` is refused as the learner refuses it (`latent_core::refused`: outside the
     latent box, `"box_exit"`; with `variance_threshold`, a GPLVM variance above it, `"variance_gate"`
-    — SPEC §3.1 step 2, §3.2): no plant step, the wrapped task's penalty, terminated. Otherwise it is decoded
-    (`model.inverse_transform`) and handed to the wrapped environment as the delta `x̂ − o` from
-    its `action_origin` `o`, which it clips to its own action space.
+    — docs/method.md §RL loop step 2, §Variance gating): no plant step, the wrapped task's penalty,
+    terminated. Otherwise it is decoded (`model.inverse_transform`) and handed to the wrapped
+    environment as the delta `x̂ − o` from its `action_origin` `o`, which it clips to its own action
+    space.
 
     `latent_box` = (low, high), each (d,); default: the bounding box of the GPLVM's latent
-    points `Z_` + 10 % per side (SPEC §4.2), or ± 3 s.d. (`explained_variance_`) for PCA.
-    `max_step`: the largest latent delta per dimension; default 0.02 × the box width
+    points `Z_` + 10 % per side (docs/method.md §RL loop), or ± 3 s.d. (`explained_variance_`) for
+    PCA. `max_step`: the largest latent delta per dimension; default 0.02 × the box width
     (about 0.4 RBF spacings of a 20-per-dimension grid).
     """
 

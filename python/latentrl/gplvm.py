@@ -1,4 +1,4 @@
-"""The GPLVM (Lawrence 2005) as in the paper (SPEC §2.2): a latent space whose GP map
+"""The GPLVM (Lawrence 2005) as in the paper (docs/method.md §GPLVM): a latent space whose GP map
 decodes to the demonstrated postures, with two inverse maps to encode."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The two inverse maps posture → latent point (paper Sec. III-B, SPEC §2.2): the
+"""The two inverse maps posture → latent point (paper Sec. III-B, docs/method.md §Encoding): the
 out-of-sample GP encoder (the paper's choice) and the iterative projection that checks it."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""PCA, the linear baseline (SPEC §2.1): fit on centred postures by SVD."""
+"""PCA, the linear baseline (docs/method.md §PCA): fit on centred postures by SVD."""
 
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
-//! The learner's parameters (paper Sec. III-D/E, SPEC §3), each declared once with its doc,
-//! default and rule ([`crate::params!`]); `Default` is the paper's Experiment 1.
+//! The learner's parameters (paper Sec. III-D/E; docs/method.md §TD(0)), each declared once with
+//! its doc, default and rule ([`crate::params!`]); `Default` is the paper's Experiment 1.
 
 use crate::params::Rule;
 use crate::{choice, params};
@@ -37,7 +37,7 @@ params! {
         /// The latent actions (paper: axes in Exp. 1, axes and diagonals in Exp. 2 and 3).
         actions: ActionSet = ActionSet::Axes => Rule::Any,
         /// A latent target whose GPLVM variance exceeds this ends the episode with the penalty
-        /// and no plant step (SPEC §3.2); none (default) turns it off.
+        /// and no plant step (docs/method.md §Variance gating); none (default) turns it off.
         variance_threshold: Option<f64> = None => Rule::Positive,
         /// Ours, not the paper's: also learn for every action a correction `C_a(z) = c_aᵀ b(z)`
         /// of its look-ahead, `Q(z, a) = V(z + Δ_a) + C_a(z)`, from each move's own outcome

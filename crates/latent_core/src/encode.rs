@@ -1,11 +1,12 @@
-//! The posture → latent maps the RL loop can encode with (step 6 of SPEC §3.1), behind one
-//! trait: a [`GpMap`]'s mean (the out-of-sample GP or the back-constraint) or a [`Projection`].
+//! The posture → latent maps the RL loop can encode with (step 6 of docs/method.md §RL loop),
+//! behind one trait: a [`GpMap`]'s mean (the out-of-sample GP or the back-constraint) or a
+//! [`Projection`].
 
 use crate::gp::{GpMap, PredictScratch};
 use crate::projection::{Projection, ProjectionScratch};
 
-/// A posture → latent map the RL loop encodes with (step 6 of SPEC §3.1): a [`GpMap`] (the
-/// out-of-sample GP or the back-constraint: its mean) or a [`Projection`].
+/// A posture → latent map the RL loop encodes with (step 6 of docs/method.md §RL loop): a [`GpMap`]
+/// (the out-of-sample GP or the back-constraint: its mean) or a [`Projection`].
 pub trait Encode: std::fmt::Debug + Send + Sync {
     /// Posture dimension D.
     fn input_dim(&self) -> usize;

@@ -1,11 +1,12 @@
-//! The episode loop of RL in latent space (paper Sec. III-E, Fig. 3; SPEC §3.1), entirely
-//! in Rust. One step from state `z_t`:
+//! The episode loop of RL in latent space (paper Sec. III-E, Fig. 3; docs/method.md §RL loop),
+//! entirely in Rust. One step from state `z_t`:
 //!
 //! 1. look-ahead `Q(z_t, u_i) = V(z_t + Δ_i)` (Eq. 11) and a soft-max draw (Eq. 10);
 //! 2. `z' = z_t + Δ_a`; outside the learner's box ⇒ penalty, terminal, no plant call
 //!    ([`EndReason::BoxExit`]);
-//! 3. decode `x̂ = μ(z')`; with variance gating on (SPEC §3.2, off by default) a variance
-//!    above the threshold ⇒ penalty, terminal, no plant call ([`EndReason::VarianceGate`]);
+//! 3. decode `x̂ = μ(z')`; with variance gating on (docs/method.md §Variance gating, off by
+//!    default) a variance above the threshold ⇒ penalty, terminal, no plant call
+//!    ([`EndReason::VarianceGate`]);
 //! 4. the plant tracks `x̂` for one RL step and reports the reached posture `x̃`, the reward
 //!    (its own penalty included) and whether the episode ended;
 //! 5. encode `z_{t+1} = g(x̃)`;
@@ -59,7 +60,7 @@ pub struct Bounds<'a> {
     pub low: &'a [f64],
     /// Upper corner of the learner's box.
     pub high: &'a [f64],
-    /// Variance gating threshold (SPEC §3.2), `None` for off.
+    /// Variance gating threshold (docs/method.md §Variance gating), `None` for off.
     pub variance_threshold: Option<f64>,
     /// Penalty of a box exit or a gated target.
     pub penalty: f64,

@@ -3,8 +3,8 @@
 
 use rand::Rng;
 
-/// How an episode ended; the codes are those of `returns.npz` (SPEC §5) and the names those
-/// of results files and Python (`END_REASONS`).
+/// How an episode ended; the codes are those of `returns.npz` (docs/method.md §Results layout) and
+/// the names those of results files and Python (`END_REASONS`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[repr(u8)]
 pub enum EndReason {
@@ -18,7 +18,8 @@ pub enum EndReason {
     Drop = 3,
     /// 4 `fall`: the robot fell.
     Fall = 4,
-    /// 5 `variance_gate`: variance gating (SPEC §3.2) refused a decoded target; ours, beyond SPEC §5.
+    /// 5 `variance_gate`: variance gating (docs/method.md §Variance gating) refused a decoded target;
+    /// ours.
     VarianceGate = 5,
     /// 6 `success`: the plant's own success rule held (a task's `target.hold_steps`: within
     /// the reach radius that many steps running). The episode ends but the state is not

@@ -1,4 +1,4 @@
-//! The iterative projection (paper Sec. III-B; SPEC §2.2, inverse map 2): a posture `x` is
+//! The iterative projection (paper Sec. III-B; docs/method.md §Encoding, map 2): a posture `x` is
 //! encoded as `argmax_z log N(x | μ(z), σ²(z) I)` under the GPLVM decoder (Eq. 4), with the
 //! analytic gradients of μ and σ² with respect to z (SE kernel, Eq. 2).
 //!

@@ -523,7 +523,7 @@ mod tests {
     // in the interior, up to ≈ 2.5 % / 7.5 % near and outside the faces, where fewer
     // centres share the normaliser and the features are larger).
     // - Inside the box: max |Δb| < 3e-3 (measured 2.9e-3 in 2-D near a face, 2.0e-3 in
-    //   4-D; PEERS.md: ≈ 2e-3).
+    //   4-D; the peer figures of benches/README.md: ≈ 2e-3).
     // - Up to half a spacing outside (where look-ahead candidates go: steps are 0.2–0.5
     //   spacings): max |Δb| < 1e-2 (the features there reach 0.3–0.4).
     const TOL_INSIDE: f64 = 3e-3;

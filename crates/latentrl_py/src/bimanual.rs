@@ -10,7 +10,8 @@ use crate::errors::{guard, to_py};
 use crate::projection::EncoderObject;
 use crate::runner::{RunArgs, episodes_in, gp_map, latent_args, pack_results, run_with_polling};
 
-/// Runs Experiment 1 (SPEC §4.1) trials in parallel in Rust and returns their records.
+/// Runs Experiment 1 (docs/method.md §Experiment 1) trials in parallel in Rust and returns their
+/// records.
 ///
 /// With `decoder`, `encoder`, `latent_low` and `latent_high` the latent learner runs (the
 /// actions of `learner`, default the 2d axes; RBFs over [latent_low, latent_high]); without

@@ -1,9 +1,9 @@
-//! Two planar arms on rapier3d 0.36.1: physics steps/s and RL steps/s (SPEC §4.2), and
-//! the two-arms task's plant ([`sim::TaskPlant`], `tasks/two_arms.toml`) alone and inside a
-//! latent learner's step.
+//! Two planar arms on rapier3d 0.36.1: physics steps/s and RL steps/s
+//! (docs/method.md §Experiment 2), and the two-arms task's plant ([`sim::TaskPlant`],
+//! `tasks/two_arms.toml`) alone and inside a latent learner's step.
 //!
-//! Peers (PEERS.md): MuJoCo 4.1 µs per step (dt 2 ms), rapier's PyPI wheel 2.4 µs; MuJoCo on
-//! the same URDF and settings is measured side by side in `benches/bench_sim.py`.
+//! Peers (benches/README.md §Peer figures): MuJoCo 4.1 µs per step (dt 2 ms), rapier's PyPI wheel
+//! 2.4 µs; MuJoCo on the same URDF and settings is measured side by side in `benches/bench_sim.py`.
 //! Run: `cargo bench -p sim --bench arms_step`.
 use std::hint::black_box;
 
@@ -32,7 +32,7 @@ const START: [f64; 4] = [0.6, -1.2, 2.5, 1.2];
 
 fn arms(options: WorldConfig) -> World {
     let mut sim = World::from_urdf_file(TWO_ARMS, options).expect("two_arms.urdf loads");
-    // The SPEC §4.2 corridor: two boxes, y ∈ [0.30, 0.37].
+    // Experiment 2's corridor (docs/method.md §Experiment 2): two boxes, y ∈ [0.30, 0.37].
     for (x0, x1) in [(-1.0, -0.36), (-0.06, 1.0)] {
         let wall = Obstacle {
             name: "corridor".to_string(),
@@ -143,8 +143,8 @@ fn arms_plant_steps(c: &mut Criterion) {
     group.finish();
 }
 
-/// One full latent RL step (SPEC §3.1: look-ahead over 8 actions, decode, plant, encode,
-/// TD update) on GP maps over a 9 × 9 latent grid of gap-crossing postures.
+/// One full latent RL step (docs/method.md §RL loop: look-ahead over 8 actions, decode, plant,
+/// encode, TD update) on GP maps over a 9 × 9 latent grid of gap-crossing postures.
 fn arms_learner_step(c: &mut Criterion) {
     let side = 9;
     let n = side * side;

@@ -1,8 +1,8 @@
 //! The KHR-1HV-like humanoid on rapier3d 0.36.1: physics steps/s of the free-floating robot
-//! standing on the ground under servo PD (SPEC §4.3; kp 8 N·m/rad, kd 0.1 N·m·s/rad, ±1.2 N·m,
-//! dt 1/240), at its home posture and at the first lift demo, with the humanoid's physics
-//! (1 solver iteration of 4 PGS passes, `tasks/humanoid_lift.toml`) and rapier's default
-//! (4 iterations of 1 pass).
+//! standing on the ground under servo PD (docs/method.md §Experiment 3; kp 8 N·m/rad, kd 0.1
+//! N·m·s/rad, ±1.2 N·m, dt 1/240), at its home posture and at the first lift demo, with the
+//! humanoid's physics (1 solver iteration of 4 PGS passes, `tasks/humanoid_lift.toml`) and rapier's
+//! default (4 iterations of 1 pass).
 //!
 //! Peer: MuJoCo on the same URDF, measured side by side in `benches/bench_sim.py`.
 //! Run: `cargo bench -p sim --bench humanoid_step`.

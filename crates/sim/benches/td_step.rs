@@ -1,8 +1,8 @@
-//! One RL step of Experiment 1 (SPEC §3.1, §4.1): soft-max look-ahead over all actions,
-//! (decode,) plant step, (encode,) features and the TD(0) update. The full-space learner
-//! uses the sparse 20⁴ grid and 12 actions; the latent learner a 20² grid, 4 actions and GP
-//! maps fitted to 50 constraint-satisfying postures. PEERS.md: NumPy 201 µs (latent),
-//! 660–1200 µs (full); target ≈ 20 µs.
+//! One RL step of Experiment 1 (docs/method.md §RL loop, §Experiment 1): soft-max look-ahead over
+//! all actions, (decode,) plant step, (encode,) features and the TD(0) update. The full-space
+//! learner uses the sparse 20⁴ grid and 12 actions; the latent learner a 20² grid, 4 actions and GP
+//! maps fitted to 50 constraint-satisfying postures. Peer figures (benches/README.md): NumPy 201 µs
+//! (latent), 660–1200 µs (full); target ≈ 20 µs.
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use latent_core::{EpisodeScratch, GpMap, Learner, LearnerConfig, SeKernel, StateSpace, trial_rng};
 use nalgebra::DMatrix;

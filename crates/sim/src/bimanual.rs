@@ -1,13 +1,13 @@
-//! Experiment 1 (SPEC §4.1, paper Sec. IV-A, Fig. 4): two planar hands carrying an object
-//! in end-effector space, as a kinematic [`Plant`], and the runner for its two learners.
+//! Experiment 1 (docs/method.md §Experiment 1, paper Sec. IV-A, Fig. 4): two planar hands carrying
+//! an object in end-effector space, as a kinematic [`Plant`], and the runner for its two learners.
 //!
 //! State (= posture) `x = (x_L, y_L, x_R, y_R)`; linear dynamics `x_{t+1} = x_t + δt·u`, so
 //! a step reaches its target exactly. The object is held while `‖(x_R − x_L) − g‖ ≤ tol`
 //! (`g = (0.1, 0)`); the hands must stay out of a disc obstacle and inside a box. The reward
 //! is `exp(−θ ‖x − x*‖²)` (Eq. 12); a step that ends the episode (obstacle, box exit, drop)
-//! earns that reward **plus** the penalty −1 (SPEC §3: "a penalty is added"; with this
+//! earns that reward **plus** the penalty −1 (the paper adds the penalty to the reward; with this
 //! reading a full-space learner that drops after ≈ 1.5 steps returns ≈ −0.92, the figure
-//! SPEC §4.1 quotes).
+//! of docs/method.md §Experiment 1).
 //!
 //! Learners: the full-space one ([`BimanualLearner::Full`]) has 12 actions
 //! ([`full_space_actions`]) and a 20⁴ RBF grid over the plant's box; the latent one
@@ -26,10 +26,11 @@ use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
 params! {
-    /// Everything about the Experiment 1 plant and its episodes; `Default` is SPEC §4.1.
+    /// Everything about the Experiment 1 plant and its episodes; `Default` is
+    /// docs/method.md §Experiment 1.
     pub struct BimanualConfig {
-        /// Drop tolerance on ‖(x_R − x_L) − grip‖ (SPEC default for RL: 0.1, about one RBF
-        /// spacing; Table I and the paper-strict variant: 0.005).
+        /// Drop tolerance on ‖(x_R − x_L) − grip‖ (for RL 0.1, about one RBF spacing,
+        /// docs/method.md §Experiment 1; Table I and the paper-strict variant: 0.005).
         drop_tolerance: f64 = 0.1 => Rule::Positive,
         /// The held object's offset x_R − x_L (paper: (0.1, 0), no rotation).
         grip: [f64; 2] = [0.1, 0.0] => Rule::Finite,
@@ -52,7 +53,7 @@ params! {
         start_sd: f64 = 0.1 => Rule::NonNegative,
         /// Penalty R_p added when a step hits the obstacle, leaves the box or drops (paper: −1).
         penalty: f64 = -1.0 => Rule::closed(-1e6, 1e6),
-        /// "Reached the target": RMS per-hand distance to x* at most this (SPEC: 0.1).
+        /// "Reached the target": RMS per-hand distance to x* at most this (ours: 0.1).
         reach_radius: f64 = 0.1 => Rule::Positive,
         /// Steps per episode before a time-out (paper: 500).
         max_steps: usize = 500 => Rule::count(1, 1_000_000),
@@ -154,7 +155,8 @@ impl Plant for BimanualPlant {
         4
     }
 
-    /// Left hand ~ N(start_mean, start_sd²·I), right hand = left + grip (SPEC §4.1).
+    /// Left hand ~ N(start_mean, start_sd²·I), right hand = left + grip
+    /// (docs/method.md §Experiment 1).
     fn sample_start<R: Rng + ?Sized>(&mut self, rng: &mut R, posture: &mut [f64]) {
         let nx: f64 = StandardNormal.sample(rng);
         let ny: f64 = StandardNormal.sample(rng);
@@ -187,8 +189,8 @@ impl Plant for BimanualPlant {
     }
 }
 
-/// The 12 full-space actions (SPEC §4.1): the 4 directions +x, −x, +y, −y applied to the
-/// left hand, the right hand, and both hands, as unit rows of a flat 12 × 4 array.
+/// The 12 full-space actions (docs/method.md §Experiment 1): the 4 directions +x, −x, +y, −y
+/// applied to the left hand, the right hand, and both hands, as unit rows of a flat 12 × 4 array.
 pub fn full_space_actions() -> Vec<f64> {
     let dirs = [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]];
     let mut actions = Vec::with_capacity(48);
@@ -244,7 +246,7 @@ impl<'a> BimanualLearner<'a> {
     }
 }
 
-/// Runs Experiment 1 trials (SPEC §4.1) in parallel: see
+/// Runs Experiment 1 trials (docs/method.md §Experiment 1) in parallel: see
 /// [`latent_core::trials::run_trials`] for seeding, cancellation and progress.
 pub fn run_bimanual_trials(
     plant: &BimanualConfig,

@@ -1,11 +1,11 @@
-//! Standing and falling (SPEC §4.3): the fall test of a free-floating robot, its centre of
-//! mass and static support margin, and a reset that stands it on a floor.
+//! Standing and falling (docs/method.md §Experiment 3): the fall test of a free-floating robot, its
+//! centre of mass and static support margin, and a reset that stands it on a floor.
 //!
 //! - **Fall** ([`FallCriteria`]): a sole tilting more than its limit (20° for the humanoid),
 //!   a non-sole link touching the floor, or the base below a height (half its standing one).
 //! - **Centre of mass** ([`center_of_mass`]): the mass-weighted mean of the URDF
 //!   `<inertial>` origins at the current link poses (not rapier's body masses, which
-//!   read differently before the first step, PITFALLS.md).
+//!   read differently before the first step, docs/pitfalls.md §rapier3d).
 //! - **Support margin** ([`support_margin`]): signed distance (m) from the centre of mass
 //!   projected on the floor to the edge of the support polygon, positive inside. The polygon
 //!   is the 2-D convex hull of the bottom corners of the sole boxes that are within
@@ -23,8 +23,8 @@ use crate::world::World;
 /// Sole corners up to this far (m) above the lowest sole corner count as touching.
 pub const SOLE_CONTACT_TOLERANCE: f64 = 2e-3;
 
-/// Thresholds of the fall test for a free-floating robot (SPEC §4.3: a sole tilting
-/// more than 20°, a non-sole body touching the floor, or the base height halving).
+/// Thresholds of the fall test for a free-floating robot (docs/method.md §Experiment 3: a sole
+/// tilting more than 20°, a non-sole body touching the floor, or the base height halving).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FallCriteria {
     /// The robot has fallen when the root link's origin is lower than this (m).

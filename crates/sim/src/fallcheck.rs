@@ -1,6 +1,6 @@
-//! The fall check (SPEC §4.3, paper Fig. 7a): drive a free-floating robot standing on the
-//! floor through a sequence of joint targets and report, per segment, whether it fell
-//! ([`crate::fall`]), its smallest support margin and its grip error (the distance between
+//! The fall check (docs/method.md §Experiment 3, paper Fig. 7a): drive a free-floating robot
+//! standing on the floor through a sequence of joint targets and report, per segment, whether it
+//! fell ([`crate::fall`]), its smallest support margin and its grip error (the distance between
 //! the two hand frames minus the object's width).
 
 use latent_core::CoreError;

@@ -1,5 +1,5 @@
-//! Kinematics of two planar 2-link arms (SPEC §4.2, paper Sec. IV-B, Fig. 5): forward
-//! kinematics of hands and elbows, and an analytic inverse for a pair of hand targets.
+//! Kinematics of two planar 2-link arms (docs/method.md §Experiment 2, paper Sec. IV-B, Fig. 5):
+//! forward kinematics of hands and elbows, and an analytic inverse for a pair of hand targets.
 //!
 //! Conventions (ours; the paper leaves them open):
 //! - A **posture** is `[q1_L, q2_L, q1_R, q2_R]` in radians: `q1` is the upper arm's angle
@@ -11,7 +11,7 @@
 //! - Angle continuity: the inverse reports the shoulder→hand direction in the window
 //!   `(shoulder_cut, shoulder_cut + 2π]`. The default cut, −π/2, points straight behind the
 //!   shoulder, so postures stay continuous (no 2π jumps) for every hand target in front of
-//!   or beside the body (PITFALLS.md, "IK angle continuity").
+//!   or beside the body (docs/pitfalls.md §GP numerics, joint angles from inverse kinematics).
 
 use crate::error::{Result, SimError, check_finite};
 use latent_core::CoreError;

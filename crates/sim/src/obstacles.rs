@@ -1,4 +1,5 @@
-//! Static obstacles and contact queries (SPEC §3: touching an obstacle ⇒ −1, terminate).
+//! Static obstacles and contact queries (docs/method.md §Reward and endings: touching an obstacle ⇒
+//! −1, terminate).
 //!
 //! Every query is an exact shape-distance test (parry) at the **current** body poses,
 //! not a read of rapier's narrow phase: the narrow phase is only refreshed inside a

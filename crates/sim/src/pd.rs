@@ -1,11 +1,11 @@
-//! PD joint servos on rapier multibody motors (SPEC §3.1 step 4: the plant tracks the
-//! decoded targets with PD control).
+//! PD joint servos on rapier multibody motors (docs/method.md §RL loop, step 4: the plant tracks
+//! the decoded targets with PD control).
 //!
 //! Each actuated joint gets a rapier position motor with the **force-based** model, so
 //! the torque is `τ = kp·(q* − q) + kd·(0 − q̇)`, clamped to `±max_force`, in N·m/rad and
 //! N·m·s/rad (N/m and N·s/m for sliders), independent of the link masses. rapier's
 //! default acceleration-based model scales the gains by the mass and behaves oddly on
-//! chains (PITFALLS.md). rapier integrates the motor implicitly, so large gains stay
+//! chains (docs/pitfalls.md §rapier3d). rapier integrates the motor implicitly, so large gains stay
 //! stable (measured stable to kp 1e5 at dt 1/240).
 //!
 //! A motor with zero stiffness and damping still locks its joint in rapier 0.36.1; a
@@ -28,7 +28,8 @@ pub struct PdGains {
 
 impl Default for PdGains {
     /// kp 5000, kd 50, no cap: tracks a 0.1 rad step on the 0.5 kg arms to < 1 mrad
-    /// within 0.05 s at dt ≤ 1/240 (PITFALLS.md; measured in `tests/pd_tracking.rs`).
+    /// within 0.05 s at dt ≤ 1/240 (docs/pitfalls.md §rapier3d; measured in
+    /// `tests/pd_tracking.rs`).
     fn default() -> Self {
         Self {
             kp: 5000.0,

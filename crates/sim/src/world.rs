@@ -1,6 +1,6 @@
 //! [`World`]: a URDF robot in a rapier3d world, PD-servoed, stepped in RL steps.
 //!
-//! One RL step (SPEC §3.1 step 4) is: [`World::set_targets`] (the decoded posture),
+//! One RL step (docs/method.md §RL loop, step 4) is: [`World::set_targets`] (the decoded posture),
 //! [`World::step_rl`] (`substeps` physics steps of `dt`), then read the reached posture
 //! ([`World::joint_positions`]), effector positions ([`World::frame_position`]) and
 //! contacts (`obstacles.rs`).

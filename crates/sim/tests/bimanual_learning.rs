@@ -1,7 +1,8 @@
-//! The episode loop learns Experiment 1 (SPEC §4.1) on short budgets: a threshold on the mean
-//! return of the last 50 of 300 episodes lies above every trial of the non-learning control
-//! (the same trials with α = 1e-12: its weights stay at w₀, a random policy) and below every
-//! trial of the learner; both run here, so the separation is re-checked on every run.
+//! The episode loop learns Experiment 1 (docs/method.md §Experiment 1) on short budgets: a
+//! threshold on the mean return of the last 50 of 300 episodes lies above every trial of the
+//! non-learning control (the same trials with α = 1e-12: its weights stay at w₀, a random policy)
+//! and below every trial of the learner; both run here, so the separation is re-checked on every
+//! run.
 
 mod common;
 
@@ -62,8 +63,9 @@ fn assert_separated(learner: &[f64], control: &[f64], threshold: f64) {
 
 #[test]
 fn full_space_learner_learns_with_forgiving_tolerance() {
-    // SPEC §4.1: at the paper's 0.005 nothing can be learnt; 0.1 (≈ one RBF spacing) can.
-    // Calibrated on 20 trials of seed 1 (AMD EPYC): learner 2.20–5.82, control 0.59–1.53.
+    // docs/method.md §Experiment 1: at the paper's 0.005 nothing can be learnt; 0.1 (≈ one RBF
+    // spacing) can. Calibrated on 20 trials of seed 1 (AMD EPYC): learner 2.20–5.82, control
+    // 0.59–1.53.
     let plant = BimanualConfig {
         drop_tolerance: 0.1,
         ..BimanualConfig::default()

@@ -1,5 +1,5 @@
-//! The KHR-1HV-like humanoid (`python/latentrl/data/khr1hv.urdf`, SPEC §4.3) stands under
-//! servo-like PD at its home posture, and the shipped lift demos hold still.
+//! The KHR-1HV-like humanoid (`python/latentrl/data/khr1hv.urdf`, docs/method.md §Experiment 3)
+//! stands under servo-like PD at its home posture, and the shipped lift demos hold still.
 use std::time::Instant;
 
 mod common;

@@ -1,5 +1,5 @@
-//! PD servo tracking on the two-arm plant (PITFALLS: force-based kp 5000 / kd 50 track a
-//! 0.1 rad step to < 1 mrad within 0.05 s at dt ≤ 1/240).
+//! PD servo tracking on the two-arm plant (docs/pitfalls.md §rapier3d: force-based kp 5000 / kd 50
+//! track a 0.1 rad step to < 1 mrad within 0.05 s at dt ≤ 1/240).
 mod common;
 
 use sim::{PdGains, PhysicsConfig, ServoConfig, WorldConfig};

@@ -1,7 +1,7 @@
-//! The humanoid lift task (`tasks/humanoid_lift.toml`, SPEC §4.3) on the generic task plant:
-//! the humanoid holds a demo pose without falling, a path into the obstacle ends on a contact,
-//! spreading the arms drops the object, starts are refused where they must be, an episode does
-//! not depend on the one before, and whole trials repeat bitwise on 1 and 2 threads.
+//! The humanoid lift task (`tasks/humanoid_lift.toml`, docs/method.md §Experiment 3) on the generic
+//! task plant: the humanoid holds a demo pose without falling, a path into the obstacle ends on a
+//! contact, spreading the arms drops the object, starts are refused where they must be, an episode
+//! does not depend on the one before, and whole trials repeat bitwise on 1 and 2 threads.
 mod common;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};

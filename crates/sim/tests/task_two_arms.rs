@@ -1,5 +1,6 @@
-//! The two-arms task (`tasks/two_arms.toml`, SPEC §4.2) on the generic task plant: walls tested
-//! on the hands, drops, rewards, "passed", and whole trials (test episodes, determinism).
+//! The two-arms task (`tasks/two_arms.toml`, docs/method.md §Experiment 2) on the generic task
+//! plant: walls tested on the hands, drops, rewards, "passed", and whole trials (test episodes,
+//! determinism).
 mod common;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
@@ -64,7 +65,8 @@ fn a_held_posture_stays_put_and_pays_the_formula() {
         let h = hands(&p);
         assert!(close(&reached, &q, 1e-4), "{reached:?} vs {q:?}");
         assert!(close(&h, &expected_hands, 1e-4), "{h:?} vs {expected_hands:?}");
-        // Reward (SPEC §4.2): exp(−0.35 ‖(h − h*)/0.3‖²) of the sim's hand frames.
+        // Reward (docs/method.md §Experiment 2): exp(−0.35 ‖(h − h*)/0.3‖²) of the sim's hand
+        // frames.
         let d2: f64 = h
             .iter()
             .zip([-0.05, 0.47, 0.05, 0.47])

@@ -57,8 +57,8 @@ class Exp2Preset(LatentRun):
 
     @classmethod
     def quick(cls) -> Exp2Preset:
-        """The CI smoke test (SPEC §4.2): w₀ = 100, step 0.5 × spacing, 300 episodes × 1000
-        steps, 3 trials, then 50 frozen test episodes from starts below the wall."""
+        """The CI smoke test (docs/method.md §Experiment 2): w₀ = 100, step 0.5 × spacing, 300
+        episodes × 1000 steps, 3 trials, then 50 frozen test episodes from starts below the wall."""
         return dataclasses.replace(
             cls(), trials=3, episodes=300, test_episodes=50,
             task={"learner.initial_weight": 100.0, "learner.step": 0.5},

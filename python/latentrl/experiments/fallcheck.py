@@ -1,5 +1,5 @@
-"""The humanoid fall check (SPEC §4.3, paper Fig. 7a): does decoding the lift demos through
-PCA or the GPLVM (d = 2) keep the KHR-1HV-like robot balanced and the grip closed?
+"""The humanoid fall check (docs/method.md §Experiment 3, paper Fig. 7a): does decoding the lift
+demos through PCA or the GPLVM (d = 2) keep the KHR-1HV-like robot balanced and the grip closed?
 
 For each method — PCA, GPLVM, and plain joint interpolation (the control) — the check
 

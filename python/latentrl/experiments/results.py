@@ -1,4 +1,5 @@
-"""Results files of a run (SPEC §5): metadata JSON and per-episode NPZ, written atomically."""
+"""Results files of a run (docs/method.md §Results layout): metadata JSON and per-episode NPZ,
+written atomically."""
 
 from __future__ import annotations
 

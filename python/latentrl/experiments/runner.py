@@ -1,5 +1,5 @@
-"""One runner for every RL experiment (SPEC §5): seed, build the learners, run the trials in
-chunks, save after each chunk, draw the figures.
+"""One runner for every RL experiment (docs/method.md §Results layout): seed, build the learners,
+run the trials in chunks, save after each chunk, draw the figures.
 
 A results directory that already holds a run of the same preset is continued: finished
 trials are kept and only the missing ones run (the trials' seeds depend on the base seed
@@ -45,7 +45,8 @@ PER_EPISODE = {
     "passed": "_passed",
 }
 """Per-episode arrays of the native call, each (trials, episodes), and the suffix of their
-key in returns.npz after the learner's name (SPEC §5: `latent`, `latent_end`, …)."""
+key in returns.npz after the learner's name (docs/method.md §Results layout: `latent`, `latent_end`,
+…)."""
 
 PER_TRIAL = {
     "test_returns": "_test",

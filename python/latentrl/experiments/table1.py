@@ -90,7 +90,8 @@ class Table1Preset:
     """GPLVM encoder of the reconstruction: "gp" (out-of-sample GP, paper), "projection" or
     "back_constrained" (the GPLVM fitted with Z = g(X)); docs/encoders.md."""
     variants: bool = True
-    """Also run the variants that move the numbers (SPEC §4.2): margin, test, demos, θ3 floor."""
+    """Also run the variants that move the numbers (docs/method.md §Table I): margin, test, demos,
+    θ3 floor."""
     variant_margins: tuple[float, ...] = (0.0, 0.1, 0.25)
     """Latent margins evaluated for the variants table (same fits, no extra cost)."""
     variant_noise_floor: float = 1e-4

@@ -1,5 +1,5 @@
 """`latentrl train`: a latent policy on any task from a demo file (or a saved GPLVM), run with
-the one runner (results layout of SPEC §5, resumable) and saved as `DIR/policy.npz`."""
+the one runner (docs/method.md §Results layout, resumable) and saved as `DIR/policy.npz`."""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-//! [`TaskPlant`]: any [`Task`] as a [`Plant`] for RL in a latent space (SPEC §3.1 steps 4–5).
+//! [`TaskPlant`]: any [`Task`] as a [`Plant`] for RL in a latent space (docs/method.md §RL loop,
+//! steps 4–5).
 //!
 //! One step: the decoded posture becomes the servo targets (clamped to the joint limits), the
 //! world advances one RL step (`physics.substeps × physics.dt`), the joint positions are read
