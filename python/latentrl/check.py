@@ -37,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl import _native
+from latentrl.physics_check import HOLD_S, servo_error, servo_tolerance
 from latentrl.task import Task, end_reasons
 
 VERDICTS = ("ok", "warning", "will not learn")
@@ -59,12 +60,6 @@ ADMISSIBLE_SHARE = 0.25
 
 PATH_SHARE = 0.5
 """Admissible points with a path to the target: a warning below this share."""
-
-HOLD_S = 0.75
-"""Seconds each demo posture is held by the servos before its effectors are compared."""
-
-MOVE_S = 0.25
-"""Seconds the servos take from one demo posture to the next."""
 
 ROUND_TRIP = 1.0
 """Learner steps a decoded posture may encode away from its latent point (the median over the
@@ -290,25 +285,12 @@ def encoder_finding(model: Any, survey: dict[str, Any]) -> Finding:
 
 def servo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
     """How far the servos leave the effectors (from the base) from up to 5 admissible demo
-    postures after moving there in `MOVE_S` and holding each `HOLD_S` (the posture put at rest is
-    the reference), against `physics.tolerance` (1 cm if none)."""
-    from latentrl.physics_check import demo_path, track
-
-    plant = task.plant(demos)
-    codes, _, _ = plant.classify(np.ascontiguousarray(demos))
-    admissible = np.flatnonzero(codes == 0)
-    if len(admissible) == 0:
+    postures after moving there and holding each (`physics_check.servo_error`), against
+    `physics.tolerance` (1 cm if none)."""
+    error = servo_error(task, demos)
+    if error is None:
         return Finding("servos", "warning", "no demo row is an admissible posture to hold", "see the demos finding")
-    order = admissible[np.linspace(0, len(admissible) - 1, min(len(admissible), 5)).round().astype(int)].tolist()
-    at_rest = np.array([_from_base(task, plant, demos[i]) for i in order])
-    plan = demo_path(task, demos, order, move_s=MOVE_S, hold_s=HOLD_S)
-    points, _ = track(task, demos, plan)
-    held = np.round(np.cumsum([HOLD_S] + [MOVE_S + HOLD_S] * (len(order) - 1)) / task.rl_dt).astype(int)
-    held = np.minimum(held, len(points) - 1)
-    reached = points[held, :-1] - points[held, -1:]
-    error = float(np.linalg.norm(reached - at_rest, axis=-1).max())
-    declared = task.to_dict()["physics"]["tolerance"]
-    tolerance = 0.01 if declared is None else declared
+    tolerance = servo_tolerance(task)
     values = {"error_m": error, "tolerance_m": tolerance}
     if error <= tolerance:
         return Finding("servos", "ok", f"the servos hold the demos within {error * 1000:.3g} mm "
@@ -317,15 +299,6 @@ def servo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
                    f"postures (tolerance {tolerance * 1000:g} mm): the servos do not hold the robot there",
                    "stiffer servos (servo.kp, with servo.kd about 2·sqrt(kp·inertia)) or higher servo.max_torque",
                    values)
-
-
-def _from_base(task: Task, plant: Any, posture: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The effectors (E, 3) of `posture` at rest, from the robot's base (a floating robot may
-    stand elsewhere after a walk of servo motions)."""
-    plant.reset(np.ascontiguousarray(posture))
-    row = np.asarray(plant.row())
-    slices = task.row_slices()
-    return np.asarray(row[slices["effectors"]].reshape(-1, 3) - row[slices["base_position"]])
 
 
 def cost_finding(task: Task, demos: NDArray[np.float64], budget: tuple[int, int], threads: int) -> Finding:

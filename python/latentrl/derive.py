@@ -6,6 +6,10 @@ the task file or a flag gives always wins; the shipped experiments name theirs.
 
 The rules (docs/tasks.md, "Settings derived from the data"):
 
+- `servo.kp`, `servo.kd` (unless any `servo.*` key is given): the defaults times the first of
+  `SERVO_SCALES` (kd also times one of `SERVO_DAMPING`) whose servos hold 5 demo postures
+  within `physics.tolerance` (1 cm if none) after moving there (`physics_check.servo_error`,
+  the check's servo finding), else the pair that came closest;
 - `learner.initial_weight` = 1 / (1 − γ): optimistic, the largest return of rewards ≤ 1, so
   unvisited states look worth visiting (the quick presets' choice, made a rule);
 - `learner.step`: the largest of 1, 1/2, 1/4, 1/8, 1/16 RBF spacings at which the target region
@@ -41,6 +45,15 @@ SLACK = 3
 MIN_STEPS = 50
 """The shortest derived episode."""
 
+SERVO_SCALES = (1.0, 4.0, 16.0, 64.0)
+"""Multiples of the default servo gains tried, both kp and kd: gains scaled with the inertia they
+move keep the servos' natural frequency and damping ratio, so this ladder fits the default's
+response to robots 4, 16 and 64 times heavier."""
+
+SERVO_DAMPING = (1.0, 2.0, 4.0)
+"""Extra kd factors tried at each scale: a longer or floating robot (more inertia per stiffness)
+needs a larger kd / kp to stay critically damped."""
+
 STOP_WINDOW = 100
 """Episodes per window of the stopping rule: a window's reach count moves by whole episodes, so
 a window of 100 sees a 1 % change of the reach rate."""
@@ -65,6 +78,9 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
     leaves open, for `task` in the latent box [`low`, `high`] of `model`."""
     out = []
     config = task.to_dict()
+    if not any(key.startswith("servo.") for key in given):
+        out += servo_gains(task, demos)
+        task = applied(task, out)  # the surveys below run moves through these servos
     if "learner.initial_weight" not in given:
         w0 = 1.0 / (1.0 - config["learner"]["gamma"])
         out.append(Derived("learner.initial_weight", w0, f"1 / (1 − γ) with γ = {config['learner']['gamma']:g}: "
@@ -95,6 +111,33 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
                            f"stop a trial after {config['episode']['stop_patience']} windows of {STOP_WINDOW} episodes "
                            "in a row without a higher reach count or a mean return 1 % higher (the budget is a ceiling)"))
     return out
+
+
+def servo_gains(task: Task, demos: NDArray[np.float64]) -> list[Derived]:
+    """`servo.kp` and `servo.kd` (module docs): the first of `SERVO_SCALES` × the default gains
+    whose servos hold the demos within the tolerance (`physics_check.servo_error`), else the one
+    that came closest."""
+    from latentrl.physics_check import servo_error, servo_tolerance
+
+    kp0, kd0 = (next(e["default"] for e in schema() if e["key"] == key) for key in ("servo.kp", "servo.kd"))
+    tolerance, tried = servo_tolerance(task), []
+    for scale in SERVO_SCALES:
+        for damping in SERVO_DAMPING:
+            gains = {"servo.kp": kp0 * scale, "servo.kd": kd0 * scale * damping}
+            error = servo_error(task.replace(gains), demos)
+            if error is None:
+                return []
+            tried.append((error, scale, damping, gains))
+            if error <= tolerance:
+                break
+        if tried[-1][0] <= tolerance:
+            break
+    error, scale, damping, gains = tried[-1] if tried[-1][0] <= tolerance else min(tried, key=lambda t: t[0])
+    held = "they hold" if error <= tolerance else "none held; these came closest"
+    rule = (f"(kp, kd) = ({kp0:g}, {kd0:g}) × {scale:g}, kd × {damping:g}: the first of the scales "
+            f"{', '.join(f'{s:g}' for s in SERVO_SCALES)} (each with kd × {', '.join(f'{d:g}' for d in SERVO_DAMPING)})"
+            f" whose servos hold 5 demo postures within {tolerance * 1000:g} mm; {held} ({error * 1000:.3g} mm)")
+    return [Derived(key, value, rule) for key, value in gains.items()]
 
 
 def applied(task: Task, derived: list[Derived] | tuple[Derived, ...]) -> Task:

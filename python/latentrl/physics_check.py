@@ -26,6 +26,47 @@ REFERENCE = {"dt": 1 / 16000, "solver_iterations": 4, "pgs_iterations": 4}
 bench's rapier reference, benches/bench_accuracy.py)."""
 
 
+HOLD_S = 0.75
+"""Seconds each demo posture is held by the servos before `servo_error` compares its effectors."""
+
+MOVE_S = 0.25
+"""Seconds the servos take from one demo posture to the next in `servo_error`."""
+
+
+def servo_tolerance(task: Task) -> float:
+    """The effector error the servos may leave (m): `physics.tolerance`, 1 cm if none."""
+    declared = task.to_dict()["physics"]["tolerance"]
+    return 0.01 if declared is None else float(declared)
+
+
+def servo_error(task: Task, demos: NDArray[np.float64]) -> float | None:
+    """The largest distance (m) of an effector (from the robot's base) from where it is at rest in
+    up to 5 admissible demo postures, after the servos moved there in `MOVE_S` and held it
+    `HOLD_S`; None if no demo row is admissible at rest."""
+    plant = task.plant(demos)
+    codes, _, _ = plant.classify(np.ascontiguousarray(demos))
+    admissible = np.flatnonzero(codes == 0)
+    if len(admissible) == 0:
+        return None
+    order = admissible[np.linspace(0, len(admissible) - 1, min(len(admissible), 5)).round().astype(int)].tolist()
+    at_rest = np.array([_from_base(task, plant, demos[i]) for i in order])
+    plan = demo_path(task, demos, order, move_s=MOVE_S, hold_s=HOLD_S)
+    points, _ = track(task, demos, plan)
+    held = np.round(np.cumsum([HOLD_S] + [MOVE_S + HOLD_S] * (len(order) - 1)) / task.rl_dt).astype(int)
+    held = np.minimum(held, len(points) - 1)
+    reached = points[held, :-1] - points[held, -1:]
+    return float(np.linalg.norm(reached - at_rest, axis=-1).max())
+
+
+def _from_base(task: Task, plant: Any, posture: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The effectors (E, 3) of `posture` at rest, from the robot's base (a floating robot may
+    stand elsewhere after a walk of servo motions)."""
+    plant.reset(np.ascontiguousarray(posture))
+    row = np.asarray(plant.row())
+    slices = task.row_slices()
+    return np.asarray(row[slices["effectors"]].reshape(-1, 3) - row[slices["base_position"]])
+
+
 def demo_path(task: Task, demos: NDArray[np.float64], order: Sequence[int], move_s: float = 0.25,
               hold_s: float = 0.75) -> NDArray[np.float64]:
     """Servo targets per RL step (steps, D): from `demos[order[0]]` along the joint-space line to
