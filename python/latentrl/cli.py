@@ -321,7 +321,9 @@ def _train(args: argparse.Namespace) -> int:
 
     base = TrainRun.quick() if args.quick else TrainRun()
     overrides = _overrides(args, TrainRun)
-    files = {"task_file": str(args.task), "demos": str(args.demos), "model": str(args.model or "")}
+    # Absolute: the run folder is read back (resume, replay, rollout) from any working directory.
+    files = {"task_file": str(args.task.resolve()), "demos": str(args.demos.resolve()),
+             "model": str(args.model.resolve()) if args.model else ""}
     run = dataclasses.replace(with_overrides(base, overrides), **files)
     meta_path = args.out / "results.json"
     if meta_path.is_file() and not args.resume:

@@ -339,12 +339,13 @@ def _check_continued(meta: Mapping[str, Any], built: Setup, arrays: Mapping[str,
 
 
 def check_inputs(recorded: Mapping[str, str], now: Mapping[str, str], out: Path) -> None:
-    """ValueError naming the first input (URDF, demos, model) whose SHA-256 the run recorded
-    and that now differs: a run is continued only with what it was made from."""
+    """ValueError naming the first input (task file, URDF, demos, model) whose SHA-256 the run
+    recorded and that now differs: a run is continued, replayed, rolled out or plotted only with
+    what it was made from."""
     for name, digest in recorded.items():
         if name in now and now[name] != digest:
             raise ValueError(f"{out}: its {name} changed since the run (sha256 {digest[:12]}… ≠ {now[name][:12]}…); "
-                             "resume refuses to mix the two: restore it, or start a new run with --out")
+                             "the run is refused rather than mixed with it: restore it, or start a new run with --out")
 
 
 def load_arrays(out_dir: Path | str) -> dict[str, np.ndarray]:

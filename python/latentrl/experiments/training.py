@@ -19,7 +19,8 @@ from latentrl.recorded.options import DemoOptions
 from latentrl.derive import Derived, applied, derive
 from latentrl.experiments.latent_runs import Fitted, latent_setup, run_fit
 from latentrl.experiments.presets import latent_box
-from latentrl.experiments.runner import Setup, finished_trials, load_arrays
+from latentrl.experiments.results import read_json
+from latentrl.experiments.runner import Setup, check_inputs, finished_trials, load_arrays
 from latentrl.gplvm import GPLVM
 from latentrl.task import Task
 from latentrl.train import LatentPolicy, TrainPreset
@@ -80,6 +81,10 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
                                run.encoder)
     if out is not None:
         model = run_fit(out, run.latent_margin, lambda: Fitted.of_model(model, run.latent_margin)).model
+        meta = Path(out) / "results.json"
+        if meta.is_file():  # a run read back (resume, replay, rollout, plot): made from these inputs?
+            recorded = read_json(meta).get("setup", {}).get("inputs") or {}
+            check_inputs(recorded, input_digests(run.task_file, task, demos, model), Path(out))
     fit = hashlib.sha256(np.ascontiguousarray(model.Z_).tobytes() + np.ascontiguousarray(demos).tobytes())
     key = (task.digest(), fit.hexdigest(), task.given, run.latent_margin)
     if key not in _DERIVED:
@@ -99,12 +104,12 @@ def setup(run: TrainRun, out: Path | None = None) -> Setup:
     task, demos, model, settings = prepared(run, out)
     built = latent_setup(run, task, model, latent_box(model.Z_, run.latent_margin), demos)
     built.info["derived"] = [d.to_dict() for d in settings]
-    built.info["inputs"] = input_digests(task, demos, model)
+    built.info["inputs"] = input_digests(run.task_file, task, demos, model)
     return built
 
 
-def input_digests(task: Task, demos: np.ndarray, model: GPLVM) -> dict[str, str]:
-    """SHA-256 of what a run is made from beyond its task keys: the URDF's bytes, the demo
+def input_digests(task_file: str, task: Task, demos: np.ndarray, model: GPLVM) -> dict[str, str]:
+    """SHA-256 of what a run is made from: the task file's and the URDF's bytes, the demo
     postures as the learner gets them (joint order, float64) and the GPLVM's arrays; a resume
     compares them (`runner.check_inputs`)."""
     def sha(data: bytes) -> str:
@@ -112,6 +117,7 @@ def input_digests(task: Task, demos: np.ndarray, model: GPLVM) -> dict[str, str]
 
     arrays = model._arrays()
     return {
+        "task file": sha(Path(task_file).read_bytes()),
         "urdf": sha(task.urdf_path.read_bytes()),
         "demos": sha(np.ascontiguousarray(demos, dtype=np.float64).tobytes()),
         "model": sha(b"".join(k.encode() + np.ascontiguousarray(arrays[k]).tobytes() for k in sorted(arrays))),
