@@ -1,0 +1,53 @@
+"""Writes demos.csv: up to 120 postures of pybullet_data's KUKA iiwa holding its flange pointing
+down (a tray on it level), the flange 0.55 m from the base axis at an azimuth in [-1.0, 1.0] rad
+(table side to shelf side) and a height in [0.40, 0.85] m, drawn from a seed. The zoo's
+iiwa_tray generator on the stock description: each posture is least squares on the plant's own
+kinematics (flange position, flange axis down, and a small pull towards one nominal elbow-up
+posture turned to the azimuth, so the demos stay on one branch of the redundancy), with the
+arm's points pushed out of the table and shelf; postures a rule refuses at rest
+(plant.classify: the mesh hulls against the boxes) are dropped.
+
+    python examples/stock/iiwa_shelf/make_demos.py [--seed 0]
+"""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parents[1] / "zoo"))
+
+from _zoo import generator, box_penetration, chain_points, write_demos, solve_ik  # noqa: E402
+
+
+BOXES = [([0.35, -0.75, 0.0], [0.85, -0.15, 0.25]), ([0.35, 0.15, 0.60], [0.85, 0.75, 0.63])]
+CHAIN = ["lbr_iiwa_link_2", "lbr_iiwa_link_4", "lbr_iiwa_link_6", "lbr_iiwa_link_7"]
+FLANGE = "lbr_iiwa_link_7"
+Q_NOM = np.array([0.0, 0.45, 0.0, -1.5, 0.0, 1.2, 0.0])  # the flange down at (0.55, 0, 0.5)
+
+
+def main() -> None:
+    rng, task, kin = generator(HERE)
+    n = 140
+    phi, z = rng.uniform(-1.0, 1.0, n), rng.uniform(0.40, 0.85, n)
+    Q = []
+    for a, h in zip(phi, z):
+        goal = np.array([0.55 * np.cos(a), 0.55 * np.sin(a), h])
+        nominal = Q_NOM + np.array([a, 0, 0, 0, 0, 0, 0])
+
+        def residual(q: np.ndarray, goal: np.ndarray = goal, nominal: np.ndarray = nominal) -> np.ndarray:
+            poses = kin.poses(q)
+            pen = [box_penetration(p, lo, hi, 0.06) for p in chain_points(kin, poses, CHAIN) for lo, hi in BOXES]
+            return np.concatenate([(kin.pos(poses, FLANGE) - goal) / 0.001,
+                                   (kin.axis(poses, FLANGE, [0, 0, 1]) - [0, 0, -1]) / 0.01,
+                                   np.array(pen) / 0.001, 0.1 * (q - nominal)])
+
+        q, _ = solve_ik(residual, nominal, kin.lower, kin.upper)
+        if np.linalg.norm(kin.pos(kin.poses(q), FLANGE) - goal) < 0.005:
+            Q.append(q)
+    write_demos(kin, np.array(Q), 120, HERE)
+
+
+if __name__ == "__main__":
+    main()
