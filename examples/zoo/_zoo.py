@@ -204,6 +204,17 @@ def box_penetration(p: NDArray[np.float64], lo: Sequence[float], hi: Sequence[fl
     return float(max(0.0, depth.min()))
 
 
+def pose_residual(kin: Kin, poses: NDArray[np.float64], link: str, goal: NDArray[np.float64], axis_to: Sequence[float],
+                  chain: Sequence[str], boxes: Sequence[tuple[Sequence[float], Sequence[float]]], inflate: float,
+                  q: NDArray[np.float64], nominal: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The IK residual of a carried or placed tool: `link` at `goal` (per mm), its z axis along
+    `axis_to` (per 0.01), the `chain` clear of the `boxes` widened by `inflate` (per mm), and the
+    joints near `nominal` (weight 0.1)."""
+    pen = [box_penetration(p, lo, hi, inflate) for p in chain_points(kin, poses, chain) for lo, hi in boxes]
+    return np.concatenate([(kin.pos(poses, link) - goal) / 0.001, (kin.axis(poses, link, [0, 0, 1]) - axis_to) / 0.01,
+                           np.array(pen) / 0.001, 0.1 * (q - nominal)])
+
+
 def solve_ik(residual: Callable[[NDArray[np.float64]], NDArray[np.float64]], q0: NDArray[np.float64],
              lower: NDArray[np.float64], upper: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
     """Least squares of `residual` within the joint limits from q0: (q, the residual's norm)."""

@@ -19,7 +19,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parents[1] / "zoo"))
 
-from _zoo import generator, box_penetration, chain_points, write_demos, solve_ik  # noqa: E402
+from _zoo import generator, pose_residual, write_demos, solve_ik  # noqa: E402
 
 
 DIVIDER = ([0.30, -0.015, 0.0], [0.70, 0.015, 0.22])
@@ -41,10 +41,7 @@ def main() -> None:
 
         def residual(q: np.ndarray, goal: np.ndarray = goal, nominal: np.ndarray = nominal) -> np.ndarray:
             poses = kin.poses(np.append(q, Q_NOM[ARM:]))
-            pen = [box_penetration(p, *DIVIDER, 0.08) for p in chain_points(kin, poses, CHAIN)]
-            return np.concatenate([(kin.pos(poses, TOOL) - goal) / 0.001,
-                                   (kin.axis(poses, TOOL, [0, 0, 1]) - [0, 0, -1]) / 0.01,
-                                   np.array(pen) / 0.001, 0.1 * (q - nominal)])
+            return pose_residual(kin, poses, TOOL, goal, [0, 0, -1], CHAIN, [DIVIDER], 0.08, q, nominal)
 
         q, _ = solve_ik(residual, nominal, lower, upper)
         q = np.append(q, Q_NOM[ARM:])

@@ -17,7 +17,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import generator, box_penetration, chain_points, write_demos, solve_ik  # noqa: E402
+from _zoo import generator, pose_residual, write_demos, solve_ik  # noqa: E402
 
 
 BOXES = [([0.35, -0.75, 0.0], [0.85, -0.15, 0.25]), ([0.35, 0.15, 0.60], [0.85, 0.75, 0.63])]
@@ -35,11 +35,7 @@ def main() -> None:
         nominal = Q_NOM + np.array([a, 0, 0, 0, 0, 0, 0])
 
         def residual(q: np.ndarray, goal: np.ndarray = goal, nominal: np.ndarray = nominal) -> np.ndarray:
-            poses = kin.poses(q)
-            pen = [box_penetration(p, lo, hi, 0.06) for p in chain_points(kin, poses, CHAIN) for lo, hi in BOXES]
-            return np.concatenate([(kin.pos(poses, "tray") - goal) / 0.001,
-                                   (kin.axis(poses, "tray", [0, 0, 1]) - [0, 0, 1]) / 0.01,
-                                   np.array(pen) / 0.001, 0.1 * (q - nominal)])
+            return pose_residual(kin, kin.poses(q), "tray", goal, [0, 0, 1], CHAIN, BOXES, 0.06, q, nominal)
 
         q, _ = solve_ik(residual, nominal, kin.lower, kin.upper)
         poses = kin.poses(q)

@@ -17,7 +17,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
-from _zoo import generator, box_penetration, chain_points, write_demos, solve_ik  # noqa: E402
+from _zoo import generator, pose_residual, write_demos, solve_ik  # noqa: E402
 
 
 DIVIDER = ([0.30, -0.015, 0.0], [0.70, 0.015, 0.22])
@@ -35,11 +35,7 @@ def main() -> None:
         nominal = Q_NOM + np.array([np.arctan2(goal[1], goal[0]), 0, 0, 0, 0, 0, 0])
 
         def residual(q: np.ndarray, goal: np.ndarray = goal, nominal: np.ndarray = nominal) -> np.ndarray:
-            poses = kin.poses(q)
-            pen = [box_penetration(p, *DIVIDER, 0.08) for p in chain_points(kin, poses, CHAIN)]
-            return np.concatenate([(kin.pos(poses, "tcp") - goal) / 0.001,
-                                   (kin.axis(poses, "tcp", [0, 0, 1]) - [0, 0, -1]) / 0.01,
-                                   np.array(pen) / 0.001, 0.1 * (q - nominal)])
+            return pose_residual(kin, kin.poses(q), "tcp", goal, [0, 0, -1], CHAIN, [DIVIDER], 0.08, q, nominal)
 
         q, _ = solve_ik(residual, nominal, kin.lower, kin.upper)
         if np.linalg.norm(kin.pos(kin.poses(q), "tcp") - goal) < 0.005:
