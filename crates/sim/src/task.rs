@@ -22,7 +22,8 @@ pub use config::{
 };
 pub use plant::TaskPlant;
 
-/// Largest task file read (bytes): a task is a page of text.
+/// Largest task file read (bytes): a task is a page of text. A FIFO, a device or a directory
+/// given as a task file is refused before it is read ([`crate::files`]).
 pub const MAX_TASK_FILE: u64 = 1 << 20;
 
 /// A checked task: its configuration and its robot, every name resolved against the URDF.
@@ -43,15 +44,7 @@ impl Task {
             origin: origin.clone(),
             reason,
         };
-        let size = std::fs::metadata(path)
-            .map_err(|e| failed(format!("cannot read it: {e}")))?
-            .len();
-        if size > MAX_TASK_FILE {
-            return Err(failed(format!(
-                "{size} bytes, more than the {MAX_TASK_FILE} a task file may have"
-            )));
-        }
-        let text = std::fs::read_to_string(path).map_err(|e| failed(format!("cannot read it: {e}")))?;
+        let text = crate::files::read_text(path, MAX_TASK_FILE, "a task file").map_err(failed)?;
         let config = parse_toml(&text).map_err(failed)?;
         Self::from_config(config, path.parent().unwrap_or(Path::new(".")), &origin)
     }

@@ -34,8 +34,9 @@ mod check;
 mod insert;
 mod lint;
 pub mod mesh;
+mod mesh_counts;
 mod repair;
-pub use check::{MAX_URDF_DEPTH, MAX_URDF_LINKS};
+pub use check::{MAX_URDF_BYTES, MAX_URDF_DEPTH, MAX_URDF_LINKS};
 use check::{check_joint_types, check_robot, check_size, inertia_problem, inertia_problems};
 pub(crate) use insert::JointSlot;
 use mesh::MeshHull;
@@ -167,8 +168,9 @@ pub struct UrdfModel {
 impl UrdfModel {
     /// Reads and checks a URDF file.
     ///
-    /// Fails with [`SimError::MissingFile`] if it cannot be read, and otherwise as
-    /// [`UrdfModel::parse_named`].
+    /// Fails with [`SimError::MissingFile`] if it cannot be read, is not a regular file (a FIFO,
+    /// a device, a directory: [`crate::files`]) or has more than [`MAX_URDF_BYTES`], and
+    /// otherwise as [`UrdfModel::parse_named`].
     pub fn from_file(path: impl AsRef<Path>) -> Result<Self> {
         Self::from_file_with_cache(path, cache::default_folder().as_deref())
     }
@@ -182,9 +184,10 @@ impl UrdfModel {
     pub fn from_file_with_options(path: impl AsRef<Path>, cache: Option<&Path>, options: LoadOptions) -> Result<Self> {
         let path = path.as_ref();
         let origin = path.display().to_string();
-        let xml = std::fs::read_to_string(path).map_err(|e| SimError::MissingFile {
+        // The variant's message says "cannot read URDF file …" already.
+        let xml = crate::files::read_text(path, MAX_URDF_BYTES, "a URDF").map_err(|reason| SimError::MissingFile {
             path: origin.clone(),
-            reason: e.to_string(),
+            reason: reason.trim_start_matches("cannot read it: ").to_string(),
         })?;
         let parent = path
             .parent()
@@ -219,7 +222,7 @@ impl UrdfModel {
     /// collision poses, negative or non-finite collision sizes, a zero axis, a length or joint
     /// limit beyond ±1000 (m or rad), or a number too large for rapier's f32 (|value| > 3.4e38);
     /// [`SimError::Mesh`] for a collision mesh that cannot be found, read or hulled
-    /// ([`mesh::load_hull`]). A document nested deeper
+    /// ([`mesh::load_hull`]). A document of more than [`MAX_URDF_BYTES`], nested deeper
     /// than [`MAX_URDF_DEPTH`] or with more than [`MAX_URDF_LINKS`] links is refused as
     /// malformed before it is parsed.
     pub fn parse_with(xml: &str, origin: &str, folder: &Path, cache: Option<&Path>) -> Result<Self> {

@@ -24,6 +24,10 @@ fn strip_comments(xml: &str) -> String {
     out
 }
 
+/// The largest URDF read (bytes), as a file or a string: real robot descriptions have 10 KB to
+/// 1 MB (a 500-link chain with visuals and comments a few MB).
+pub const MAX_URDF_BYTES: u64 = 16 << 20;
+
 /// The deepest element nesting a URDF may have (real robot descriptions nest < 10 levels; the
 /// XML parser recurses per level, and 50 000 levels overflowed the stack).
 pub const MAX_URDF_DEPTH: usize = 256;
@@ -32,9 +36,16 @@ pub const MAX_URDF_DEPTH: usize = 256;
 /// (300 links 0.3 s, 1000 links 10 s) and does not poll Ctrl-C.
 pub const MAX_URDF_LINKS: usize = 500;
 
-/// Refuses, before the XML parser runs, a document nested deeper than [`MAX_URDF_DEPTH`] or
-/// with more than [`MAX_URDF_LINKS`] `<link` elements (a scan of the text, comments removed).
+/// Refuses, before the XML parser runs, a document of more than [`MAX_URDF_BYTES`], nested
+/// deeper than [`MAX_URDF_DEPTH`] or with more than [`MAX_URDF_LINKS`] `<link` elements (a scan
+/// of the text, comments removed).
 pub(super) fn check_size(xml: &str, origin: &str) -> Result<()> {
+    if xml.len() as u64 > MAX_URDF_BYTES {
+        return Err(SimError::MalformedUrdf {
+            origin: origin.to_string(),
+            reason: crate::files::too_large(xml.len() as u64, MAX_URDF_BYTES, "a URDF"),
+        });
+    }
     let clean = strip_comments(xml);
     let bytes = clean.as_bytes();
     let (mut depth, mut deepest, mut links) = (0usize, 0usize, 0usize);

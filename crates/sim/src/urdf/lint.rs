@@ -27,23 +27,23 @@ pub(crate) struct Scan {
     pub no_range: HashSet<String>,
 }
 
-/// One tag of the document.
-struct Tag<'a> {
+/// One tag of the document (also of a COLLADA mesh: [`super::mesh_counts`]).
+pub(super) struct Tag<'a> {
     /// 1-based line of its `<`.
-    line: usize,
+    pub line: usize,
     /// Byte range of the whole tag, `<` to `>` inclusive.
-    start: usize,
-    end: usize,
-    name: &'a str,
+    pub start: usize,
+    pub end: usize,
+    pub name: &'a str,
     /// The text after the name, up to (not including) `>` or `/>`; offset `attrs_at`.
-    attrs: &'a str,
+    pub attrs: &'a str,
     attrs_at: usize,
-    closing: bool,
-    self_closing: bool,
+    pub closing: bool,
+    pub self_closing: bool,
 }
 
 /// `<!-- … -->` comments replaced by spaces, newlines kept (so lines still count).
-fn blank_comments(xml: &str) -> String {
+pub(super) fn blank_comments(xml: &str) -> String {
     let mut out = String::with_capacity(xml.len());
     let mut rest = xml;
     while let Some(start) = rest.find("<!--") {
@@ -60,7 +60,7 @@ fn blank_comments(xml: &str) -> String {
 }
 
 /// The tags of `text` (comments already blanked), in order; `<?…?>` and `<!…>` skipped.
-fn tags(text: &str) -> Vec<Tag<'_>> {
+pub(super) fn tags(text: &str) -> Vec<Tag<'_>> {
     let bytes = text.as_bytes();
     let mut out = Vec::new();
     let (mut line, mut counted) = (1usize, 0usize);
@@ -110,7 +110,7 @@ fn tags(text: &str) -> Vec<Tag<'_>> {
 }
 
 /// `(name, value, byte range of the value in the tag's attrs)` of every attribute.
-fn attributes(attrs: &str) -> Vec<(&str, &str, usize, usize)> {
+pub(super) fn attributes(attrs: &str) -> Vec<(&str, &str, usize, usize)> {
     let mut out = Vec::new();
     let bytes = attrs.as_bytes();
     let mut i = 0;

@@ -17,7 +17,7 @@ use std::path::{Component, Path, PathBuf};
 use rapier3d::parry::transformation::try_convex_hull;
 use rapier3d::prelude::{SharedShape, Vector};
 
-use super::cache;
+use super::{cache, mesh_counts};
 
 /// The largest mesh file read (bytes): bounds the memory a malformed or huge mesh takes.
 pub const MAX_MESH_BYTES: u64 = 128 << 20;
@@ -117,11 +117,12 @@ fn package_root(name: &str, urdf_dir: &Path) -> Option<PathBuf> {
 /// `cache` if given and the hull is there; stored there otherwise).
 ///
 /// Errors (a sentence naming what was wrong; the caller adds the link and the path): a file
-/// that is missing, unreadable, larger than [`MAX_MESH_BYTES`] or not a mesh the readers
-/// know; a mesh without triangles, with more than [`MAX_MESH_TRIANGLES`], with a non-finite
-/// vertex, or flat (no volume: no hull).
+/// that is missing, unreadable, not a regular file, larger than [`MAX_MESH_BYTES`], declaring
+/// more values than it holds ([`super::mesh_counts`]) or not a mesh the readers know; a mesh
+/// without triangles, with more than [`MAX_MESH_TRIANGLES`], with a non-finite vertex, or flat
+/// (no volume: no hull).
 pub fn load_hull(path: &Path, scale: [f64; 3], cache: Option<&Path>) -> Result<MeshHull, String> {
-    let bytes = read_bounded(path)?;
+    let bytes = crate::files::read_bounded(path, MAX_MESH_BYTES, "a mesh file")?;
     let key = cache::key(&bytes, scale);
     let entry = cache.and_then(|dir| cache::read(dir, &key));
     // An entry whose hull has no volume is damaged: ignored like any other, and rewritten.
@@ -165,45 +166,32 @@ fn is_flat(points: &[[f32; 3]], triangles: &[[u32; 3]]) -> bool {
     volume.abs().partial_cmp(&(1e-9 * diagonal.powi(3))) != Some(std::cmp::Ordering::Greater)
 }
 
-/// The bytes of a regular file of at most [`MAX_MESH_BYTES`] (a device such as /dev/zero or a
-/// FIFO is refused, and a file growing while read is cut at the limit and refused).
-fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
-    use std::io::Read;
-    let cannot = |e: std::io::Error| format!("cannot read it: {e}");
-    let meta = std::fs::metadata(path).map_err(cannot)?;
-    if !meta.is_file() {
-        return Err("is not a regular file".to_string());
-    }
-    let too_big = |size: u64| format!("{size} bytes, more than the {MAX_MESH_BYTES} a mesh file may have");
-    if meta.len() > MAX_MESH_BYTES {
-        return Err(too_big(meta.len()));
-    }
-    let mut bytes = Vec::with_capacity(meta.len() as usize);
-    std::fs::File::open(path)
-        .and_then(|f| f.take(MAX_MESH_BYTES + 1).read_to_end(&mut bytes))
-        .map_err(cannot)?;
-    if bytes.len() as u64 > MAX_MESH_BYTES {
-        return Err(too_big(bytes.len() as u64));
-    }
-    Ok(bytes)
+/// The refusal of a mesh of `triangles` > [`MAX_MESH_TRIANGLES`].
+pub(super) fn too_many_triangles(triangles: usize) -> String {
+    format!(
+        "has {triangles} triangles, more than the {MAX_MESH_TRIANGLES} a collision mesh may have \
+         (simplify it first, e.g. with a decimation in MeshLab or Blender)"
+    )
 }
 
 /// Every vertex of every mesh in the file, scaled, and the number of triangles.
 fn read_points(bytes: &[u8], path: &Path, scale: [f64; 3]) -> Result<(Vec<Vector>, usize), String> {
     // OBJ material libraries are not needed for collisions: refuse to read them.
     let no_materials = |_: &Path| Err(std::io::Error::other("materials are not read"));
-    let scene = mesh_loader::Loader::default()
-        .load_from_slice_with_reader(bytes, path, no_materials)
+    // The counts the file declares fit in its bytes: the reader allocates what they say.
+    mesh_counts::check(bytes, path)?;
+    // The reader asserts on some malformed files (a COLLADA input naming another mesh's
+    // vertices): a panic there is this file's error, not the caller's.
+    let load = || mesh_loader::Loader::default().load_from_slice_with_reader(bytes, path, no_materials);
+    let scene = std::panic::catch_unwind(std::panic::AssertUnwindSafe(load))
+        .map_err(|_| "made the mesh reader fail (a malformed file)".to_string())?
         .map_err(|e| format!("is not a mesh the STL, OBJ and COLLADA readers accept: {e}"))?;
     let triangles: usize = scene.meshes.iter().map(|m| m.faces.len()).sum();
     if triangles == 0 {
         return Err("has no triangles".to_string());
     }
     if triangles > MAX_MESH_TRIANGLES {
-        return Err(format!(
-            "has {triangles} triangles, more than the {MAX_MESH_TRIANGLES} a collision mesh may have \
-             (simplify it first, e.g. with a decimation in MeshLab or Blender)"
-        ));
+        return Err(too_many_triangles(triangles));
     }
     let s = scale.map(|v| v as f32);
     let mut points = Vec::new();

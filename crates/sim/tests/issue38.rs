@@ -1,0 +1,158 @@
+//! Issue #38, item 5: files read only if regular and under their cap (a FIFO answers at once,
+//! a device or an oversized file is refused naming the cap), mesh counts checked against the
+//! bytes present.
+use std::path::{Path, PathBuf};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use sim::{MAX_URDF_BYTES, SimError, Task, UrdfModel};
+
+/// A fresh empty folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("latentrl-issue38-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `f()` run on a thread, or a failure if it has not answered within 10 s (a blocking read).
+fn within<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    rx.recv_timeout(Duration::from_secs(10))
+        .expect("no answer within 10 s: the read blocked")
+}
+
+fn mkfifo(path: &Path) {
+    let made = std::process::Command::new("mkfifo").arg(path).status().unwrap();
+    assert!(made.success(), "mkfifo {}", path.display());
+}
+
+const INERTIAL: &str =
+    r#"<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>"#;
+
+/// A one-link robot whose collision shape is the mesh `mesh` (a path relative to the URDF).
+fn mesh_robot(mesh: &str) -> String {
+    format!(
+        r#"<robot name="m"><link name="base">{INERTIAL}<collision><geometry><mesh filename="{mesh}"/></geometry></collision></link></robot>"#
+    )
+}
+
+/// A binary STL of the unit cube (12 triangles, 8 vertices).
+fn cube_stl() -> Vec<u8> {
+    let c = |i: usize| [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32];
+    let faces = [
+        [0, 2, 1],
+        [1, 2, 3],
+        [4, 5, 6],
+        [5, 7, 6],
+        [0, 1, 4],
+        [1, 5, 4],
+        [2, 6, 3],
+        [3, 6, 7],
+        [0, 4, 2],
+        [2, 4, 6],
+        [1, 3, 5],
+        [3, 7, 5],
+    ];
+    let mut out = vec![0u8; 80];
+    out.extend((faces.len() as u32).to_le_bytes());
+    for f in faces {
+        out.extend([0u8; 12]);
+        out.extend(f.iter().flat_map(|&i| c(i)).flat_map(f32::to_le_bytes));
+        out.extend([0u8; 2]);
+    }
+    out
+}
+
+#[test]
+fn issue38_a_fifo_as_urdf_task_or_mesh_is_refused_at_once() {
+    let dir = scratch("fifo");
+    let fifo = dir.join("pipe");
+    mkfifo(&fifo);
+    let at = fifo.clone();
+    let err = within(move || UrdfModel::from_file_with_cache(&at, None).unwrap_err());
+    assert!(matches!(err, SimError::MissingFile { .. }), "{err}");
+    assert!(
+        err.to_string().contains("pipe: is not a regular file (a FIFO)"),
+        "{err}"
+    );
+
+    let at = fifo.clone();
+    let err = within(move || Task::load(&at).unwrap_err()).to_string();
+    assert!(err.contains("pipe: is not a regular file (a FIFO)"), "{err}");
+
+    std::fs::write(dir.join("robot.urdf"), mesh_robot("pipe")).unwrap();
+    let urdf = dir.join("robot.urdf");
+    let err = within(move || UrdfModel::from_file_with_cache(&urdf, None).unwrap_err()).to_string();
+    assert!(err.contains("collision mesh of link \"base\""), "{err}");
+    assert!(err.contains("is not a regular file (a FIFO)"), "{err}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn issue38_devices_directories_and_files_over_the_cap_are_refused_naming_the_cap() {
+    let err = UrdfModel::from_file_with_cache("/dev/zero", None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("/dev/zero: is not a regular file (a character device)"),
+        "{err}"
+    );
+    let err = Task::load("/dev/zero").unwrap_err().to_string();
+    assert!(err.contains("is not a regular file (a character device)"), "{err}");
+    let dir = scratch("cap");
+    let err = Task::load(&dir).unwrap_err().to_string();
+    assert!(err.contains("is not a regular file (a directory)"), "{err}");
+
+    let big = dir.join("big.toml");
+    std::fs::write(&big, vec![b'#'; (1 << 20) + 1]).unwrap();
+    let err = Task::load(&big).unwrap_err().to_string();
+    assert!(
+        err.contains("is 1048577 bytes, more than the 1048576 bytes (1 MiB) a task file may have"),
+        "{err}"
+    );
+    let big = dir.join("big.urdf");
+    std::fs::write(&big, vec![b' '; MAX_URDF_BYTES as usize + 1]).unwrap();
+    let err = UrdfModel::from_file_with_cache(&big, None).unwrap_err().to_string();
+    assert!(
+        err.contains("more than the 16777216 bytes (16 MiB) a URDF may have"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn issue38_mesh_counts_beyond_their_bytes_are_refused_before_reading() {
+    let dir = scratch("counts");
+    // 1 KB of COLLADA declaring 2·10⁹ floats: the reader would have asked for 8 GB and aborted.
+    let dae = r##"<?xml version="1.0"?><COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+<library_geometries><geometry id="g"><mesh><source id="p"><float_array id="a" count="2000000000">0 0 0 1 0 0 0 1 0 0 0 1</float_array>
+<technique_common><accessor source="#a" count="4" stride="3"><param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor></technique_common></source>
+<vertices id="v"><input semantic="POSITION" source="#p"/></vertices>
+<triangles count="4"><input semantic="VERTEX" source="#v" offset="0"/><p>0 2 1 0 1 3 0 3 2 1 2 3</p></triangles></mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="s"><node><instance_geometry url="#g"/></node></visual_scene></library_visual_scenes><scene><instance_visual_scene url="#s"/></scene></COLLADA>"##;
+    std::fs::write(dir.join("bomb.dae"), dae).unwrap();
+    std::fs::write(dir.join("robot.urdf"), mesh_robot("bomb.dae")).unwrap();
+    let err = UrdfModel::from_file_with_cache(dir.join("robot.urdf"), None).unwrap_err();
+    let SimError::Mesh { reason, .. } = &err else {
+        panic!("{err}")
+    };
+    assert!(
+        reason.contains("line 2: <float_array> declares count=2000000000 values but holds 12"),
+        "{reason}"
+    );
+    // The same file with a truthful count loads.
+    std::fs::write(dir.join("bomb.dae"), dae.replace("2000000000", "12")).unwrap();
+    UrdfModel::from_file_with_cache(dir.join("robot.urdf"), None).unwrap();
+
+    let mut stl = cube_stl();
+    stl[80..84].copy_from_slice(&4_000_000_000u32.to_le_bytes());
+    std::fs::write(dir.join("cube.stl"), &stl).unwrap();
+    std::fs::write(dir.join("robot.urdf"), mesh_robot("cube.stl")).unwrap();
+    let err = UrdfModel::from_file_with_cache(dir.join("robot.urdf"), None).unwrap_err();
+    assert!(err.to_string().contains("declares 4000000000 triangles"), "{err}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
