@@ -216,7 +216,9 @@ impl UrdfModel {
     /// continuous, prismatic or fixed (including unknown type strings);
     /// [`SimError::MalformedUrdf`] for bad XML, duplicate names, joints naming missing links,
     /// a mimic joint naming no moving joint or in a cycle of mimics,
-    /// a link with two parents, empty or non-finite limits, a moving link without mass, a
+    /// a joint graph that is not one tree (a joint joining a link to itself, a link with two
+    /// parents, a cycle of joints, several root links: the joints and links named), empty or
+    /// non-finite limits, a moving link without mass, a
     /// link with mass whose inertia tensor is not positive definite, breaks the triangle
     /// inequality or has a radius of gyration outside [1 µm, 1 km], non-finite inertial or
     /// collision poses, negative or non-finite collision sizes, a zero axis, a length or joint

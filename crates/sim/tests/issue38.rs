@@ -1,6 +1,6 @@
-//! Issue #38, item 5: files read only if regular and under their cap (a FIFO answers at once,
+//! Issue #38, items 4–5: files read only if regular and under their cap (a FIFO answers at once,
 //! a device or an oversized file is refused naming the cap), mesh counts checked against the
-//! bytes present.
+//! bytes present, URDF joint graphs that are not one tree refused naming their joints.
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
@@ -155,4 +155,80 @@ fn issue38_mesh_counts_beyond_their_bytes_are_refused_before_reading() {
     let err = UrdfModel::from_file_with_cache(dir.join("robot.urdf"), None).unwrap_err();
     assert!(err.to_string().contains("declares 4000000000 triangles"), "{err}");
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A robot of links `a`, `b`, `c` (and `d`) joined by `joints`, each `(name, parent, child)`.
+fn graph(joints: &[(&str, &str, &str)], links: &[&str]) -> String {
+    let links: String = links
+        .iter()
+        .map(|l| format!(r#"<link name="{l}">{INERTIAL}</link>"#))
+        .collect();
+    let joints: String = joints
+        .iter()
+        .map(|(n, p, c)| {
+            format!(
+                r#"<joint name="{n}" type="revolute"><parent link="{p}"/><child link="{c}"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"#
+            )
+        })
+        .collect();
+    format!(r#"<robot name="g">{links}{joints}</robot>"#)
+}
+
+fn refused(xml: &str) -> String {
+    match UrdfModel::parse_with(xml, "g.urdf", Path::new("."), None) {
+        Err(SimError::MalformedUrdf { reason, .. }) => reason,
+        Err(other) => panic!("expected a malformed URDF, got {other}"),
+        Ok(_) => panic!("loaded: {xml}"),
+    }
+}
+
+#[test]
+fn issue38_joint_graphs_that_are_not_one_tree_are_refused_naming_their_joints() {
+    let abc = ["a", "b", "c"];
+    let ok = graph(&[("shoulder", "a", "b"), ("elbow", "b", "c")], &abc);
+    UrdfModel::parse_with(&ok, "g.urdf", Path::new("."), None).unwrap();
+
+    let err = refused(&graph(
+        &[("shoulder", "a", "b"), ("elbow", "b", "c"), ("loop", "c", "c")],
+        &abc,
+    ));
+    assert!(
+        err.contains(r#"joint "loop" has link "c" as both its parent and its child"#),
+        "{err}"
+    );
+
+    let err = refused(&graph(
+        &[("shoulder", "a", "b"), ("elbow", "b", "c"), ("again", "a", "c")],
+        &abc,
+    ));
+    assert!(
+        err.contains(r#"link "c" is the child of two joints, "elbow" (parent "b") and "again" (parent "a")"#),
+        "{err}"
+    );
+
+    // A 2-cycle beside the root: its links are reachable from no root.
+    let err = refused(&graph(
+        &[("shoulder", "a", "b"), ("there", "c", "d"), ("back", "d", "c")],
+        &["a", "b", "c", "d"],
+    ));
+    assert!(err.contains("form a cycle"), "{err}");
+    assert!(
+        err.contains(r#""there" ("c" -> "d")"#) && err.contains(r#""back" ("d" -> "c")"#),
+        "{err}"
+    );
+    assert!(err.contains("lead to no root link"), "{err}");
+
+    // A 3-cycle with no root at all.
+    let err = refused(&graph(&[("ab", "a", "b"), ("bc", "b", "c"), ("ca", "c", "a")], &abc));
+    assert!(
+        err.contains(r#""ab""#) && err.contains(r#""bc""#) && err.contains(r#""ca""#),
+        "{err}"
+    );
+
+    // Two roots: a link no joint reaches.
+    let err = refused(&graph(&[("shoulder", "a", "b")], &abc));
+    assert!(
+        err.contains(r#"2 links are the child of no joint: "a" (a tree of 2 links), "c" (a tree of 1 links)"#),
+        "{err}"
+    );
 }

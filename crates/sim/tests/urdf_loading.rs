@@ -105,7 +105,8 @@ fn structural_errors_are_malformed_urdf() {
 
 #[test]
 fn missing_mesh_names_its_link_and_the_path_tried() {
-    let mesh = r#"<link name="m"><collision><geometry><mesh filename="a.stl"/></geometry></collision></link>"#;
+    let mesh = r#"<link name="m"><collision><geometry><mesh filename="a.stl"/></geometry></collision></link>
+        <joint name="f" type="fixed"><parent link="arm"/><child link="m"/></joint>"#;
     let err = UrdfModel::parse(&robot(&format!("{HINGE}{mesh}"))).unwrap_err();
     assert!(
         matches!(&err, SimError::Mesh { link, path, .. } if link == "m" && path.ends_with("a.stl")),

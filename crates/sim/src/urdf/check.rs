@@ -184,7 +184,6 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<(Vec<J
         check_collisions(link).map_err(bad)?;
     }
     let mut joint_names = HashSet::new();
-    let mut children = HashSet::new();
     let mut actuated = Vec::new();
     let mut followers = Vec::new();
     for joint in &robot.joints {
@@ -199,9 +198,9 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<(Vec<J
                 )));
             }
         }
-        if !children.insert(joint.child.link.as_str()) {
-            return Err(bad(format!("link {:?} is the child of two joints", joint.child.link)));
-        }
+    }
+    check_tree(robot).map_err(bad)?;
+    for joint in &robot.joints {
         let owner = format!("joint {:?}", joint.name);
         check_magnitudes(&owner, joint_numbers(joint)).map_err(bad)?;
         check_lengths(&owner, joint.origin.xyz.0.map(|v| ("origin xyz", v)).to_vec()).map_err(bad)?;
@@ -272,6 +271,88 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<(Vec<J
     }
     let mimics = couple(&actuated, &followers).map_err(bad)?;
     Ok((actuated, mimics))
+}
+
+/// Refuses a joint graph that is not one tree (issue #38): a joint whose parent is its child,
+/// a link that is the child of two joints, joints that form a cycle (its links reachable from
+/// no root), several root links. rapier3d-urdf builds a multibody from any of them: a
+/// self-loop reached an LU panic, a 2-cycle loaded as a normal arm with the cycle's links
+/// cut off from the shoulder. Every link and joint is named; every joint names existing links.
+fn check_tree(robot: &urdf_rs::Robot) -> std::result::Result<(), String> {
+    use std::collections::HashMap;
+    let mut parent_joint: HashMap<&str, &urdf_rs::Joint> = HashMap::new();
+    for joint in &robot.joints {
+        let (parent, child) = (joint.parent.link.as_str(), joint.child.link.as_str());
+        if parent == child {
+            return Err(format!(
+                "joint {:?} has link {parent:?} as both its parent and its child: a joint joins two links",
+                joint.name
+            ));
+        }
+        if let Some(first) = parent_joint.insert(child, joint) {
+            return Err(format!(
+                "link {child:?} is the child of two joints, {:?} (parent {:?}) and {:?} (parent {parent:?}): \
+                 each link has one parent joint (a closed chain is not supported)",
+                first.name, first.parent.link, joint.name
+            ));
+        }
+    }
+    // Up from each link along parent joints: a walk that comes back to a link of its own is a
+    // cycle, and its links lead to no root.
+    let mut done: HashSet<&str> = HashSet::new();
+    for link in &robot.links {
+        let mut walk: Vec<&str> = Vec::new();
+        let mut at = link.name.as_str();
+        while !done.contains(at) {
+            if let Some(k) = walk.iter().position(|l| *l == at) {
+                // Parent to child: each link's parent joint, the walk reversed.
+                let cycle: Vec<&urdf_rs::Joint> = walk[k..].iter().rev().map(|l| parent_joint[l]).collect();
+                let joints: Vec<String> = cycle
+                    .iter()
+                    .map(|j| format!("{:?} ({:?} -> {:?})", j.name, j.parent.link, j.child.link))
+                    .collect();
+                let links: Vec<String> = cycle.iter().map(|j| format!("{:?}", j.parent.link)).collect();
+                return Err(format!(
+                    "joints {} form a cycle: links {} lead to no root link",
+                    joints.join(", "),
+                    links.join(", ")
+                ));
+            }
+            walk.push(at);
+            match parent_joint.get(at) {
+                Some(j) => at = j.parent.link.as_str(),
+                None => break,
+            }
+        }
+        done.extend(walk);
+    }
+    let roots: Vec<&str> = robot
+        .links
+        .iter()
+        .map(|l| l.name.as_str())
+        .filter(|l| !parent_joint.contains_key(l))
+        .collect();
+    if roots.len() > 1 {
+        let under = |link: &str, root: &str| {
+            let mut at = link;
+            while let Some(j) = parent_joint.get(at) {
+                at = j.parent.link.as_str();
+            }
+            at == root
+        };
+        let size = |root: &str| robot.links.iter().filter(|l| under(&l.name, root)).count();
+        let listed: Vec<String> = roots
+            .iter()
+            .map(|r| format!("{r:?} (a tree of {} links)", size(r)))
+            .collect();
+        return Err(format!(
+            "{} links are the child of no joint: {}; a robot has one root link, and every other link \
+             is reachable from it (join the others to the tree with a joint, e.g. type=\"fixed\")",
+            roots.len(),
+            listed.join(", ")
+        ));
+    }
+    Ok(())
 }
 
 /// Resolves every mimic joint to the actuated joint at the end of its chain of leaders
