@@ -266,7 +266,9 @@ impl UrdfModel {
             hulls: Vec::new(),
             warnings,
         };
-        model.hulls = model.load_hulls(cache)?;
+        let mut notes = Vec::new();
+        model.hulls = model.load_hulls(cache, &mut notes)?;
+        model.warnings.extend(notes);
         model.balance_inertia(options.balance_inertia)?;
         Ok(model)
     }
@@ -332,13 +334,21 @@ impl UrdfModel {
     }
 
     /// What was repaired while loading (xacro leftovers, ranges, spherical joints, inertias),
-    /// one sentence each naming the line, joint or link; empty for a clean URDF.
+    /// one sentence each naming the line, joint or link, and the hull cache folder or entries
+    /// not used and why ([`cache`]); empty for a clean URDF and cache.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
     }
 
-    /// The convex hull of every mesh collision shape ([`mesh::load_hull`]).
-    fn load_hulls(&self, cache: Option<&Path>) -> Result<Vec<((usize, usize), MeshHull)>> {
+    /// The convex hull of every mesh collision shape ([`mesh::load_hull`]); a cache folder that
+    /// others may write is not used, and that, and each cache entry not used, is a sentence in
+    /// `warnings`.
+    fn load_hulls(&self, cache: Option<&Path>, warnings: &mut Vec<String>) -> Result<Vec<((usize, usize), MeshHull)>> {
+        let meshes = self.robot.links.iter().flat_map(|l| &l.collision);
+        let has_mesh = meshes
+            .into_iter()
+            .any(|c| matches!(c.geometry, urdf_rs::Geometry::Mesh { .. }));
+        let cache = cache.filter(|dir| !has_mesh || cache::trusted(dir).map_err(|why| warnings.push(why)).is_ok());
         let mut out = Vec::new();
         for (l, link) in self.robot.links.iter().enumerate() {
             for (c, collision) in link.collision.iter().enumerate() {
@@ -353,7 +363,8 @@ impl UrdfModel {
                 };
                 let path = mesh::resolve(filename, &self.folder).map_err(|e| failed(filename.clone(), e))?;
                 let scale = scale.map_or([1.0; 3], |s| s.0);
-                let hull = mesh::load_hull(&path, scale, cache).map_err(|e| failed(path.display().to_string(), e))?;
+                let hull = mesh::load_hull(&path, scale, cache, warnings)
+                    .map_err(|e| failed(path.display().to_string(), e))?;
                 out.push(((l, c), hull));
             }
         }

@@ -1,10 +1,12 @@
-//! Issue #38, items 4–5: files read only if regular and under their cap (a FIFO answers at once,
+//! Issue #38, items 3–5: files read only if regular and under their cap (a FIFO answers at once,
 //! a device or an oversized file is refused naming the cap), mesh counts checked against the
-//! bytes present, URDF joint graphs that are not one tree refused naming their joints.
+//! bytes present, URDF joint graphs that are not one tree refused naming their joints, and a
+//! hull cache that is verified, not trusted.
 use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
 
+use sim::urdf::cache::MAX_CACHE_ENTRY_BYTES;
 use sim::{MAX_URDF_BYTES, SimError, Task, UrdfModel};
 
 /// A fresh empty folder for one test.
@@ -231,4 +233,172 @@ fn issue38_joint_graphs_that_are_not_one_tree_are_refused_naming_their_joints() 
         err.contains(r#"2 links are the child of no joint: "a" (a tree of 2 links), "c" (a tree of 1 links)"#),
         "{err}"
     );
+}
+
+/// A folder with `cube.stl` and `robot.urdf` colliding with it; the URDF's path.
+fn cube_robot(dir: &Path) -> PathBuf {
+    std::fs::write(dir.join("cube.stl"), cube_stl()).unwrap();
+    let urdf = dir.join("robot.urdf");
+    std::fs::write(&urdf, mesh_robot("cube.stl")).unwrap();
+    urdf
+}
+
+/// The one entry of a cache folder.
+fn entry(cache: &Path) -> PathBuf {
+    let entries: Vec<PathBuf> = std::fs::read_dir(cache).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(entries.len(), 1, "{entries:?}");
+    entries[0].clone()
+}
+
+/// An entry in the cache's format: `points`, `triangles`, and the source's triangle count.
+fn entry_bytes(points: &[[f32; 3]], triangles: &[[u32; 3]], source: u32) -> Vec<u8> {
+    let mut out = b"LRHULL01".to_vec();
+    for word in [points.len() as u32, triangles.len() as u32, source] {
+        out.extend(word.to_le_bytes());
+    }
+    out.extend(points.iter().flatten().flat_map(|v| v.to_le_bytes()));
+    out.extend(triangles.iter().flatten().flat_map(|i| i.to_le_bytes()));
+    out
+}
+
+/// Whether the first collision hull of `model` came from the cache.
+fn cached(model: &UrdfModel) -> bool {
+    model.collision_shapes()[0].hull.unwrap().2
+}
+
+#[test]
+fn issue38_a_tampered_cache_entry_is_not_used() {
+    let dir = scratch("tamper");
+    let cache = dir.join("cache");
+    let urdf = cube_robot(&dir);
+    let fresh = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
+    let again = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
+    assert!(!cached(&fresh) && cached(&again) && again.warnings().is_empty());
+    let file = entry(&cache);
+
+    // A hull of four of the cube's own corners (the vertex check passes): the rest of the cube
+    // lies outside it.
+    let tetra = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let faces = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+    let forgeries = [
+        (
+            entry_bytes(&tetra, &faces, 12),
+            "mesh vertices lie outside its triangle",
+        ),
+        (
+            entry_bytes(&tetra.map(|p| p.map(|c| c * 0.5)), &faces, 12),
+            "is no vertex of the mesh",
+        ),
+        (entry_bytes(&tetra, &faces[..3], 12), "do not close one surface"),
+        (
+            entry_bytes(&tetra, &faces, 7),
+            "records 7 triangles in the mesh, which has 12",
+        ),
+        (
+            entry_bytes(&tetra, &[[0, 1, 9]], 12),
+            "has a triangle naming point 9 of 4",
+        ),
+        (b"LRHULL01\xff\xff\xff\xff".to_vec(), "too few for its counts"),
+    ];
+    for (forged, why) in forgeries {
+        std::fs::write(&file, forged).unwrap();
+        let model = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
+        assert!(!cached(&model), "a forged entry was used ({why})");
+        assert_eq!(model.hull_points(), fresh.hull_points());
+        let warnings = model.warnings().join("\n");
+        assert!(
+            warnings.contains(why) && warnings.contains("not used"),
+            "{why}: {warnings}"
+        );
+        // Computed anew and rewritten: the next load is a clean hit.
+        assert!(cached(&UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap()));
+    }
+
+    // Not a regular private file of at most its cap: not read.
+    std::fs::remove_file(&file).unwrap();
+    mkfifo(&file);
+    let (u, c) = (urdf.clone(), cache.clone());
+    let model = within(move || UrdfModel::from_file_with_cache(&u, Some(&c)).unwrap());
+    assert!(
+        model.warnings()[0].contains("is not a regular file (a FIFO): not used"),
+        "{:?}",
+        model.warnings()
+    );
+    std::fs::remove_file(&file).unwrap();
+    std::fs::write(&file, vec![0u8; MAX_CACHE_ENTRY_BYTES as usize + 1]).unwrap();
+    let model = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
+    assert!(
+        model.warnings()[0].contains("(16 MiB) a hull cache entry may have"),
+        "{:?}",
+        model.warnings()
+    );
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let model = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
+        assert!(cached(&model), "rewritten by the load before");
+        std::fs::set_permissions(&file, std::fs::Permissions::from_mode(0o666)).unwrap();
+        let model = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
+        assert!(!cached(&model));
+        assert!(
+            model.warnings()[0].contains("is writable by other users (mode 666)"),
+            "{:?}",
+            model.warnings()
+        );
+        let mode = std::fs::metadata(&file).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o600, "entries are written private");
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[cfg(unix)]
+#[test]
+fn issue38_a_cache_folder_others_may_write_warns_and_is_not_used() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("shared-cache");
+    let urdf = cube_robot(&dir);
+    let cache = dir.join("cache");
+    std::fs::create_dir(&cache).unwrap();
+    std::fs::set_permissions(&cache, std::fs::Permissions::from_mode(0o777)).unwrap();
+    for _ in 0..2 {
+        let model = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
+        assert!(!cached(&model));
+        let warning = model.warnings().join("\n");
+        assert!(
+            warning.contains(&format!(
+                "hull cache folder {} is writable by other users (mode 777): not used",
+                cache.display()
+            )),
+            "{warning}"
+        );
+    }
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 0, "nothing written to it");
+
+    // A private folder inside a folder anyone may write (no sticky bit): they could replace it.
+    std::fs::set_permissions(&cache, std::fs::Permissions::from_mode(0o700)).unwrap();
+    let inner = cache.join("hulls");
+    std::fs::set_permissions(&cache, std::fs::Permissions::from_mode(0o777)).unwrap();
+    let model = UrdfModel::from_file_with_cache(&urdf, Some(&inner)).unwrap();
+    assert!(
+        model.warnings()[0].contains("which any user may write (mode 777)"),
+        "{:?}",
+        model.warnings()
+    );
+    std::fs::set_permissions(&cache, std::fs::Permissions::from_mode(0o755)).unwrap();
+
+    // Owned by another user (possible to set up only as root).
+    let owned = std::process::Command::new("chown").arg("65534").arg(&cache).status();
+    if owned.is_ok_and(|s| s.success()) {
+        let model = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
+        assert!(!cached(&model));
+        assert!(
+            model.warnings()[0].contains("is owned by user 65534, not by us"),
+            "{:?}",
+            model.warnings()
+        );
+    }
+    // A robot without meshes never reads the cache: no warning.
+    let model = UrdfModel::parse_with(&graph(&[("j", "a", "b")], &["a", "b"]), "g", &dir, Some(&cache)).unwrap();
+    assert!(model.warnings().is_empty());
+    std::fs::remove_dir_all(dir).unwrap();
 }
