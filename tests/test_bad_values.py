@@ -72,6 +72,14 @@ def test_a_task_override_names_the_key_and_the_rule(key, value, says):
         Task.shipped(task_for(key)).replace({key: value})
 
 
+@pytest.mark.parametrize("key", ["servo.kp", "servo.kd", "physics.joint_damping"])
+def test_a_gain_beyond_f32_is_refused_not_made_infinite(key):
+    """Issue #38: rapier stores gains as f32; 1e300 passed as finite and became inf there."""
+    with pytest.raises(ValueError, match=rf"{re.escape(key)}\b.*must lie in \[0, 3.4028234663852886e38\], got 1e300$"):
+        Task.shipped("two_arms").replace({key: 1e300})
+    assert Task.shipped("two_arms").replace({key: 1e30}).to_dict()[key.split(".")[0]][key.split(".")[1]] == 1e30
+
+
 FLAG_CASES = [(k, v, s) for k, v, s in CASES if not isinstance(v, str) and s != "invalid type"]
 """The cases a flag can carry: argparse refuses a word where a number goes (exit 2, naming the
 flag), and a number given to a text key's flag is that text."""

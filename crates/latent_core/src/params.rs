@@ -122,7 +122,7 @@ impl fmt::Display for Rule {
             Rule::Finite => write!(f, "must be a finite number"),
             Rule::Positive => write!(f, "must be a finite number > 0"),
             Rule::NonNegative => write!(f, "must be a finite number >= 0"),
-            Rule::AtLeast(low) => write!(f, "must be >= {low} (inf allowed)"),
+            Rule::AtLeast(low) => write!(f, "must be >= {} (inf allowed)", Short(low)),
             Rule::Interval {
                 low,
                 high,
@@ -130,8 +130,10 @@ impl fmt::Display for Rule {
                 high_open,
             } => write!(
                 f,
-                "must lie in {}{low}, {high}{}",
+                "must lie in {}{}, {}{}",
                 if low_open { "(" } else { "[" },
+                Short(low),
+                Short(high),
                 if high_open { ")" } else { "]" }
             ),
             Rule::Count { min, max } => write!(f, "must be an integer in [{min}, {max}]"),
@@ -179,7 +181,21 @@ fn number(v: f64, rule: &Rule, path: &str) -> Result<(), ParamError> {
     if rule.admits(v) {
         Ok(())
     } else {
-        Err(ParamError::new(path, format!("{rule}, got {v}")))
+        Err(ParamError::new(path, format!("{rule}, got {}", Short(v))))
+    }
+}
+
+/// A number as a message says it: as written for everyday magnitudes, in exponent form beyond
+/// 1e16 (f32's largest is 3.4028234663852886e38, not 39 digits).
+struct Short(f64);
+
+impl fmt::Display for Short {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0.is_finite() && self.0.abs() >= 1e16 {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
     }
 }
 

@@ -9,6 +9,10 @@ use latent_core::params::{ParamError, Rule, join};
 use crate::pd::PdGains;
 use crate::urdf::RootMode;
 
+/// The rule of a servo gain or a damping: ≥ 0 and within f32 (rapier stores them as f32, where a
+/// larger value would become infinite).
+const GAIN: Rule = Rule::closed(0.0, f32::MAX as f64);
+
 params! {
     /// The physics world: time step, sub-steps, solver, gravity, contacts.
     pub struct PhysicsConfig {
@@ -26,7 +30,7 @@ params! {
         gravity: [f64; 3] = [0.0, 0.0, -9.81] => Rule::closed(-1000.0, 1000.0),
         /// Viscous joint damping (N·m·s/rad) where the URDF has no `<dynamics damping>`; 0
         /// replaces rapier's implicit 0.1, so all damping comes from the servos' kd.
-        joint_damping: f64 = 0.0 => Rule::NonNegative,
+        joint_damping: f64 = 0.0 => GAIN,
         /// Let links of the robot collide with each other (adjacent links never do).
         self_collisions: bool = false => Rule::Any,
         /// With self_collisions: pairs of links that still never collide, e.g.
@@ -45,9 +49,9 @@ params! {
     /// Overrides of one joint's servo.
     pub struct JointServo {
         /// Stiffness kp (N·m/rad or N/m).
-        kp: Option<f64> = None => Rule::NonNegative,
+        kp: Option<f64> = None => GAIN,
         /// Damping kd (N·m·s/rad or N·s/m).
-        kd: Option<f64> = None => Rule::NonNegative,
+        kd: Option<f64> = None => GAIN,
         /// Torque (force) cap (N·m or N); inf for none.
         max_force: Option<f64> = None => Rule::AtLeast(0.0),
     }
@@ -58,9 +62,9 @@ params! {
     pub struct ServoConfig {
         /// Stiffness kp of every joint (N·m/rad); kp 5000 / kd 50 track a 0.1 rad step of the
         /// 0.5 kg arms to < 1 mrad in 0.05 s.
-        kp: f64 = 5000.0 => Rule::NonNegative,
+        kp: f64 = 5000.0 => GAIN,
         /// Damping kd of every joint (N·m·s/rad).
-        kd: f64 = 50.0 => Rule::NonNegative,
+        kd: f64 = 50.0 => GAIN,
         /// Torque cap of every joint (N·m); inf for none.
         max_force: f64 = f64::INFINITY => Rule::AtLeast(0.0),
         /// Cap each servo's torque at its URDF `limit.effort` too, where given.
