@@ -129,7 +129,7 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
                          f"got {postures.shape}")
     preset = TrainPreset()
     if model is None:
-        model = GPLVM(n_components=2, random_state=0, max_iter=preset.gplvm_max_iter).fit(postures)
+        model = GPLVM(n_components=2, random_state=0, max_iter=preset.gplvm_max_iter, encoder=preset.encoder).fit(postures)
     low, high = latent_box(model.Z_, preset.latent_margin if latent_margin is None else latent_margin)
     if demo_finding(task, postures).verdict != "will not learn":  # else nothing to derive from: say why
         task = applied(task, derive(task, model, low, high, postures, set(task.given)))

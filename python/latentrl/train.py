@@ -44,6 +44,10 @@ class TrainPreset(LatentRun):
     """Training episodes per trial (ours: 2000)."""
     test_episodes: int = 20
     """Frozen test episodes per trial after training (no TD updates, the task's test starts; ours: 20)."""
+    encoder: str = "tracking"
+    """Posture → latent map of the RL loop (presets.LatentRun.encoder): "tracking" for a task of your own
+    (on the robot zoo at the default budget it matched the paper's "gp" on one robot and raised the
+    greedy reach rate on two, 52 → 90 % and 22 → 46 %; docs/encoders.md)."""
 
     def validate(self) -> None:
         """ValueError naming the first impossible field."""

@@ -109,7 +109,7 @@ class LatentRun:
     gplvm_max_iter: int = 1000
     """L-BFGS iteration cap of the GPLVM fit."""
     encoder: str = "gp"
-    """Posture → latent map of the RL loop: "gp" (the paper's out-of-sample GP onto the fitted points), "projection" (the latent point of highest density under the decoder, iterated from the nearest demo) "back_constrained" (the GPLVM fitted with Z = g(X), encoding its demos exactly) or "tracking" (the projection searched from the latent point the move commanded: a tracked posture keeps its point; docs/encoders.md)."""
+    """Posture → latent map of the RL loop: "gp" (the paper's out-of-sample GP onto the fitted points), "projection" (the latent point of highest density under the decoder, iterated from the nearest demo), "back_constrained" (the GPLVM fitted with Z = g(X), encoding its demos exactly) or "tracking" (the projection searched from the latent point the move commanded: a tracked posture keeps its point; docs/encoders.md)."""
     latent_margin: float = 0.1
     """Latent box = bounding box of the fitted latent points, widened by this share per side (ours: 10 %)."""
     task: Mapping[str, Any] = field(default_factory=dict)
