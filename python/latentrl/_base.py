@@ -12,7 +12,7 @@ import uuid
 import warnings
 import zipfile
 import zlib
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Collection, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, ClassVar, Self
@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from scipy.optimize import minimize
 from scipy.spatial.distance import pdist
 
+from latentrl._files import open_regular
 from latentrl._native import LatentrlError, gplvm_nll_grad
 from latentrl._validation import as_matrix
 
@@ -72,7 +73,8 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
 
 
 MAX_NPZ_BYTES = 2**30
-"""The most bytes of arrays an NPZ file read by latentrl (a model, a run's returns) may unpack to."""
+"""The most bytes an NPZ file read by latentrl (a model, a run's returns) may have, and the most
+bytes of arrays it may unpack to."""
 
 
 class _TooLarge(ValueError):
@@ -99,10 +101,11 @@ def _check_npz_sizes(fh: IO[bytes]) -> None:
                                     f"member holds {member.file_size}")
 
 
-def read_npz(path: PathLike) -> dict[str, NDArray[Any]]:
-    """Every array of the NPZ file at `path`, read eagerly without pickles; a file that
-    is not a readable NPZ is a ValueError."""
-    with open(path, "rb") as fh:
+def read_npz(path: PathLike, keys: Collection[str] | None = None) -> dict[str, NDArray[Any]]:
+    """Every array of the NPZ file at `path` (those named in `keys` if given), read eagerly
+    without pickles; a file that is not a regular file of at most MAX_NPZ_BYTES
+    (`latentrl._files`) or not a readable NPZ is a ValueError."""
+    with open_regular(path, MAX_NPZ_BYTES, "an NPZ file") as fh:
         magic = fh.read(6)
         if magic.startswith(b"\x93NUMPY"):
             raise ValueError("not a readable NPZ file: it holds a single array (.npy), not an NPZ archive")
@@ -116,7 +119,7 @@ def read_npz(path: PathLike) -> dict[str, NDArray[Any]]:
             if not isinstance(npz, np.lib.npyio.NpzFile):
                 raise ValueError("it holds a single array, not an NPZ archive")
             with npz:
-                return {key: npz[key] for key in npz.files}
+                return {key: npz[key] for key in npz.files if keys is None or key in keys}
         except _TooLarge as err:
             raise ValueError(f"refused NPZ file: {err}") from None
         except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as err:

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import atomic_path
+from latentrl._base import atomic_path, read_npz
 from latentrl.render import VIEWS
 
 #: What `replay` writes, by suffix.
@@ -237,8 +237,11 @@ def rollout_episode(out: Path, policy: str, trial: int, episode: int, view: str 
         raise ValueError(f"--trial {trial}: the rollout ran trials {trials}")
     moved = out / meta.get("policy_from_out", "")  # the rollout and its run moved together
     saved = LatentPolicy.load(moved if moved.is_file() else Path(meta["policy"]))
-    with np.load(out / "rollout.npz") as npz:
-        paths = npz[f"{policy}_paths"][trials.index(trial)]
+    try:
+        arrays = read_npz(out / "rollout.npz", keys=[f"{policy}_paths"])
+    except ValueError as err:
+        raise ValueError(f"{out / 'rollout.npz'}: {err}") from None
+    paths = arrays[f"{policy}_paths"][trials.index(trial)]
     if not 0 <= episode < len(paths):
         raise ValueError(f"--episode {episode}: the rollout recorded episodes 0..{len(paths) - 1}")
     rows = paths[episode][np.isfinite(paths[episode]).all(axis=1)]

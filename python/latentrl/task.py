@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl import _native
+from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded, read_text
 
 SHIPPED = ("two_arms", "humanoid_lift")
 """The task files shipped in `latentrl/tasks/`: Experiment 2's arms and Experiment 3's lift."""
@@ -115,7 +116,11 @@ class Task:
         """Reads a TOML task file; an error names the file, the key and the rule (ValueError)."""
         path = Path(path)
         native = _native.Task.load(path)  # checked (size, syntax, keys) before it is read here
-        written = key_paths(tomllib.loads(path.read_text()))
+        try:
+            text = read_text(path, MAX_TASK_FILE_BYTES, "a task file")  # it may have changed since
+        except ValueError as err:
+            raise ValueError(f"{path}: {err}") from None
+        written = key_paths(tomllib.loads(text))
         return cls(native, path.parent, frozenset(written))
 
     @classmethod
@@ -151,7 +156,10 @@ class Task:
         """SHA-256 of the effective configuration and the URDF's text: what a saved policy
         records, so that it is not run on another task."""
         text = json.dumps(self.to_dict(), sort_keys=True, allow_nan=True)
-        urdf = self.urdf_path.read_bytes()
+        try:
+            urdf = read_bounded(self.urdf_path, MAX_URDF_BYTES, "a URDF")
+        except ValueError as err:
+            raise ValueError(f"{self.urdf_path}: {err}") from None
         return hashlib.sha256(text.encode() + b"\0" + urdf).hexdigest()
 
     def plant(self, demos: NDArray[np.float64] | None = None) -> _native.TaskPlant:

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from latentrl._base import atomic_write
+from latentrl._files import MAX_JSON_BYTES, read_text
 
 RESULTS_FORMAT = 1
 """Version of the results layout; bumped when a file changes meaning."""
@@ -48,11 +49,14 @@ def write_npz(path: Path, arrays: Mapping[str, np.ndarray]) -> None:
 
 
 def read_json(path: Path) -> dict[str, Any]:
-    """A results JSON, or a ValueError naming the file if it is not one."""
+    """A results JSON, or a ValueError naming the file if it is not one (or not a regular file of
+    at most `MAX_JSON_BYTES`)."""
     try:
-        payload = json.loads(Path(path).read_text())
+        payload = json.loads(read_text(path, MAX_JSON_BYTES, "a JSON file of a run"))
     except json.JSONDecodeError as err:
         raise ValueError(f"{path}: not valid JSON ({err})") from err
+    except ValueError as err:
+        raise ValueError(f"{path}: {err}") from None
     if not isinstance(payload, dict):
         raise ValueError(f"{path}: expected a JSON object at the top level")
     return payload

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NamedTuple
 
+from latentrl._files import MAX_SWEEP_FILE_BYTES, read_text
 from latentrl.experiments.presets import describe, with_overrides
 from latentrl.experiments.registry import rl_experiments, task_schema
 from latentrl.task import by_path, key_paths
@@ -172,7 +173,10 @@ def load_sweep(path: Path | str) -> Sweep:
     """A sweep from a TOML file (or YAML, `.yaml`/`.yml`, if PyYAML is installed); a file that
     is not one, or holds a bad value, is a ValueError naming the file and the value."""
     path = Path(path)
-    text = path.read_text()
+    try:
+        text = read_text(path, MAX_SWEEP_FILE_BYTES, "a sweep file")
+    except ValueError as err:
+        raise ValueError(f"{path}: {err}") from None
     if path.suffix.lower() in (".yaml", ".yml"):
         try:
             yaml: Any = importlib.import_module("yaml")
