@@ -211,7 +211,12 @@ def test_a_200_frame_960_wide_clip_streams_in_bounded_memory(tmp_path, suffix):
     out = tmp_path / f"clip{suffix}"
     done = subprocess.run([sys.executable, "-c", STREAM, str(out)], capture_output=True, text=True, check=True)
     assert int(done.stdout.split()[-1]) < 300
-    assert sum(1 for _ in iio.imiter(out)) == 200
+    if suffix == ".gif":
+        assert iio.improps(out).shape[0] == 200
+    else:  # ffmpeg counts the frames itself (imageio's reader may leave its pipe to the GC)
+        import imageio_ffmpeg
+
+        assert imageio_ffmpeg.count_frames_and_secs(str(out))[0] == 200
 
 
 def test_a_rerun_recording_draws_mesh_links_as_their_hulls(tmp_path):
