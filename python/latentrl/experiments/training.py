@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded
 from latentrl.demos import load_demos
 from latentrl.recorded import recording_kind
 from latentrl.recorded.options import DemoOptions
@@ -117,8 +118,8 @@ def input_digests(task_file: str, task: Task, demos: np.ndarray, model: GPLVM) -
 
     arrays = model._arrays()
     return {
-        "task file": sha(Path(task_file).read_bytes()),
-        "urdf": sha(task.urdf_path.read_bytes()),
+        "task file": sha(read_bounded(task_file, MAX_TASK_FILE_BYTES, "a task file")),
+        "urdf": sha(read_bounded(task.urdf_path, MAX_URDF_BYTES, "a URDF")),
         "demos": sha(np.ascontiguousarray(demos, dtype=np.float64).tobytes()),
         "model": sha(b"".join(k.encode() + np.ascontiguousarray(arrays[k]).tobytes() for k in sorted(arrays))),
     }
