@@ -19,8 +19,6 @@ from typing import IO, Any, ClassVar, Self
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import minimize
-from scipy.spatial.distance import pdist
 
 from latentrl._files import open_regular
 from latentrl._native import LatentrlError, gplvm_nll_grad
@@ -439,6 +437,8 @@ def initial_log_theta(
     """Starting log θ for a GP from `inputs` (N, q) to `centred` outputs (N, p): θ1 the mean
     output variance, θ2 the median squared distance between inputs, θ3 = θ1 / 100
     (1 where a scale is zero)."""
+    from scipy.spatial.distance import pdist  # SciPy loads at a fit, not at `import latentrl`
+
     variance = float(np.mean(centred**2)) or 1.0
     lengthscale_sq = float(np.median(pdist(inputs, "sqeuclidean"))) or 1.0
     # Clamped at the smallest normal float: data of scale 1e-161 underflows θ3 to 0.
@@ -463,6 +463,8 @@ def lbfgs(objective: Callable[[NDArray[np.float64]], tuple[float, NDArray[np.flo
     """scipy's L-BFGS-B on `objective` (value and gradient), stopping when the relative decrease
     of the objective or the largest projected gradient falls below `tol`, or after `max_iter`
     iterations: the one optimiser call of every likelihood fit here."""
+    from scipy.optimize import minimize
+
     return minimize(objective, x0, jac=True, method="L-BFGS-B", bounds=bounds,
                     options={"maxiter": max_iter, "ftol": tol, "gtol": tol})
 

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
+import sys
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.sparse import issparse
 
 
 class ComplexDataError(TypeError, ValueError):
@@ -57,7 +57,8 @@ def _floats(name: str, value: Any, expected: str) -> NDArray[np.float64]:
     """`value` as a float64 array, or a TypeError naming `name` and what was `expected`
     (a sparse matrix too; complex values too, as a `ComplexDataError`: casting would
     silently drop their imaginary parts)."""
-    if issparse(value):
+    sparse = sys.modules.get("scipy.sparse")  # a sparse matrix exists only once SciPy made one
+    if sparse is not None and sparse.issparse(value):
         raise TypeError(
             f"{name}: sparse input is not supported, expected {expected} "
             f"(densify it: {name}.toarray())"

@@ -10,10 +10,8 @@ from numpy.typing import NDArray
 
 from latentrl._base import Estimator, SavedSpec, column_names, initial_log_theta, minimise_nll
 from latentrl import _native
-from latentrl.back_constraint import minimise_back_constrained
 from latentrl._native import GpMap
 from latentrl._validation import as_matrix, int_at_least, positive
-from latentrl.inverse import Projection, fit_gp_encoder
 from latentrl.pca import PCA, check_n_components
 
 ENCODERS = ("gp", "projection", "back_constrained", "tracking")
@@ -214,6 +212,10 @@ class GPLVM(Estimator):
         starts = [start] + [
             start + RESTART_SCALE * rng.standard_normal(start.shape) for _ in range(n_restarts)
         ]
+        # SciPy (L-BFGS-B, the encoders' factorisations) loads at a fit, not at `import latentrl`.
+        from latentrl.back_constraint import minimise_back_constrained
+        from latentrl.inverse import fit_gp_encoder
+
         back_constrained = self.encoder == "back_constrained"
         if back_constrained and self.latent_prior:
             raise ValueError("latent_prior: the back-constrained latent points are a function of X, "
@@ -280,6 +282,8 @@ class GPLVM(Estimator):
             self.encoder_ = GpMap.back_constraint(self.X_train_, self.encoder_weights_, log_beta)
         else:
             self.encoder_ = GpMap(self.X_train_, self.Z_, self.encoder_theta_)
+        from latentrl.inverse import Projection
+
         self.projection_ = Projection(self.Z_, self.X_train_, self.theta_, self.decoder_.jitter)
         self.native_projection_ = _native.Projection(self.decoder_, self.X_train_)
 
