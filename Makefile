@@ -59,6 +59,7 @@ test-all: lint $(VENV)/.sb3 ## everything, slow reproductions and the SB3 exampl
 bench: build ## criterion benches, the NumPy loop, GPy, MuJoCo and Pinocchio comparisons (JSON in benches/results/)
 	cargo bench -p latent_core -p sim
 	$(PY) benches/bench_td.py
+	$(PY) benches/bench_startup.py
 	bash benches/setup_bench_env.sh
 	benches/.venv-bench/bin/python benches/bench_gp.py
 	benches/.venv-bench/bin/python benches/bench_sim.py
