@@ -24,6 +24,7 @@ The rules (docs/tasks.md, "Settings derived from the data"):
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 from typing import Any
 
@@ -101,7 +102,7 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
         survey = survey or _survey(task.replace({"learner.step": step}), model, low, high, demos)
         moves = survey["moves"][survey["moves"] >= 0]
         if len(moves):
-            default = next(e["default"] for e in schema() if e["key"] == "episode.max_steps")
+            default = _default("episode.max_steps")
             needed = int(np.percentile(moves, 95))
             value = int(min(default, max(MIN_STEPS, SLACK * needed)))
             out.append(Derived("episode.max_steps", value, f"{SLACK} × the {needed} moves 95 % of admissible starts "
@@ -119,20 +120,18 @@ def servo_gains(task: Task, demos: NDArray[np.float64]) -> list[Derived]:
     that came closest."""
     from latentrl.physics_check import servo_error, servo_tolerance
 
-    kp0, kd0 = (next(e["default"] for e in schema() if e["key"] == key) for key in ("servo.kp", "servo.kd"))
+    kp0, kd0 = _default("servo.kp"), _default("servo.kd")
     tolerance, tried = servo_tolerance(task), []
-    for scale in SERVO_SCALES:
-        for damping in SERVO_DAMPING:
-            gains = {"servo.kp": kp0 * scale, "servo.kd": kd0 * scale * damping}
-            error = servo_error(task.replace(gains), demos)
-            if error is None:
-                return []
-            tried.append((error, scale, damping, gains))
-            if error <= tolerance:
-                break
-        if tried[-1][0] <= tolerance:
+    for scale, damping in itertools.product(SERVO_SCALES, SERVO_DAMPING):
+        gains = {"servo.kp": kp0 * scale, "servo.kd": kd0 * scale * damping}
+        error = servo_error(task.replace(gains), demos)
+        if error is None:
+            return []
+        tried.append((error, scale, damping, gains))
+        if error <= tolerance:
             break
-    error, scale, damping, gains = tried[-1] if tried[-1][0] <= tolerance else min(tried, key=lambda t: t[0])
+    # The first pair that holds is also the closest: every pair before it missed the tolerance.
+    error, scale, damping, gains = min(tried, key=lambda t: t[0])
     held = "they hold" if error <= tolerance else "none held; these came closest"
     rule = (f"(kp, kd) = ({kp0:g}, {kd0:g}) × {scale:g}, kd × {damping:g}: the first of the scales "
             f"{', '.join(f'{s:g}' for s in SERVO_SCALES)} (each with kd × {', '.join(f'{d:g}' for d in SERVO_DAMPING)})"
@@ -143,6 +142,11 @@ def servo_gains(task: Task, demos: NDArray[np.float64]) -> list[Derived]:
 def applied(task: Task, derived: list[Derived] | tuple[Derived, ...]) -> Task:
     """`task` with the `derived` settings set (its origin kept, for error messages)."""
     return task.replace({d.key: d.value for d in derived}, origin=task.origin)
+
+
+def _default(key: str) -> Any:
+    """The schema's default of task key `key`."""
+    return next(e["default"] for e in schema() if e["key"] == key)
 
 
 def _survey(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.float64],

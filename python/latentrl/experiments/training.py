@@ -33,9 +33,9 @@ class TrainRun(TrainPreset, DemoOptions):
     read), and the model."""
 
     task_file: str = ""
-    """The task file (TOML), as given."""
+    """The task file (TOML); `latentrl train` records it as an absolute path."""
     demos: str = ""
-    """The demonstrations (CSV with a header of joint names, NPZ, JSON, or a recording: docs/demos.md), as given."""
+    """The demonstrations (CSV with a header of joint names, NPZ, JSON, or a recording: docs/demos.md); `latentrl train` records an absolute path."""
     model: str = ""
     """A saved GPLVM to use instead of fitting one to the demos ("" = fit, d = 2)."""
 
