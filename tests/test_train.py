@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import re
+import signal
+import time
 from pathlib import Path
 
 import numpy as np
@@ -42,6 +44,28 @@ def test_readme_tutorial_learns(
 @pytest.fixture(scope="module")
 def arms_model() -> GPLVM:
     return GPLVM(n_components=2, max_iter=50, random_state=0).fit(arm_postures(40, np.random.default_rng(1)))
+
+
+def test_ctrl_c_stops_training_inside_its_start_draws(arms_model: GPLVM) -> None:
+    """Issue #38: Ctrl-C is read before every start draw and step, not between episodes: a test
+    episode whose every start is refused, allowed 10⁹ draws (≈ 2 h here), stops within seconds
+    of the signal (SIGALRM raising KeyboardInterrupt, as Ctrl-C does, half a second in). A step
+    inside a long episode: `latent_core`'s trials test."""
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGALRM, interrupt)
+    signal.setitimer(signal.ITIMER_REAL, 0.5)
+    began = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            train_latent_policy(arms_model, trials=1, episodes=1, test_episodes=1, overrides={
+                "episode.max_start_draws": 10**9, "episode.test_start": "below_waypoint", "waypoint.below": -1000.0})
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+    assert time.monotonic() - began < 30  # a hang guard, not a speed bound: the draws take hours
 
 
 def test_same_seed_same_policy_and_value_matches_weights(arms_model: GPLVM) -> None:

@@ -19,6 +19,8 @@
 //! terminal state: the last update bootstraps; so does a plant's success
 //! ([`EndReason::is_terminal`]).
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rand::{Rng, RngExt};
 
 use crate::error::{CoreError, Result};
@@ -223,10 +225,26 @@ impl Learner {
         rng: &mut R,
         s: &mut EpisodeScratch,
     ) -> Result<()> {
+        self.start_unless(plant, space, rng, s, &NEVER)
+    }
+
+    /// [`Self::start`], giving up with [`CoreError::Cancelled`] once `cancel` is set (read
+    /// before every draw: `max_start_draws` may be 10⁹).
+    fn start_unless<P: Plant, R: Rng + ?Sized>(
+        &self,
+        plant: &mut P,
+        space: &StateSpace<'_>,
+        rng: &mut R,
+        s: &mut EpisodeScratch,
+        cancel: &AtomicBool,
+    ) -> Result<()> {
         let draws = self.rules.max_start_draws;
         let gate = self.config.variance_threshold;
         let mut admitted = false;
         for _ in 0..draws {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(CoreError::Cancelled);
+            }
             let t = &mut s.step;
             match self.rules.start {
                 StartMode::Plant => {
@@ -303,11 +321,14 @@ impl Learner {
         s: &mut EpisodeScratch,
         trajectory: Option<&mut Vec<f64>>,
     ) -> Result<EpisodeRecord> {
-        self.run_episode_with(plant, space, rng, None::<&mut R>, s, trajectory)
+        self.run_episode_with(plant, space, rng, None::<&mut R>, s, trajectory, &NEVER)
     }
 
     /// [`Self::run_episode`] with the start drawn from `rng` and, if given, the actions from
-    /// `actions` (a rollout: so policies that draw differently meet the same starts).
+    /// `actions` (a rollout: so policies that draw differently meet the same starts). Once
+    /// `cancel` is set (read before every start draw and every step) it stops with
+    /// [`CoreError::Cancelled`], the learner holding the updates of the steps it ran.
+    #[allow(clippy::too_many_arguments)]
     pub fn run_episode_with<P: Plant, R: Rng + ?Sized, A: Rng + ?Sized>(
         &mut self,
         plant: &mut P,
@@ -316,8 +337,9 @@ impl Learner {
         mut actions: Option<&mut A>,
         s: &mut EpisodeScratch,
         mut trajectory: Option<&mut Vec<f64>>,
+        cancel: &AtomicBool,
     ) -> Result<EpisodeRecord> {
-        self.start(plant, space, rng, s)?;
+        self.start_unless(plant, space, rng, s, cancel)?;
         let task_dim = plant.task_dim();
         let record_row = |plant: &P, traj: &mut Option<&mut Vec<f64>>| {
             if let Some(t) = traj.as_deref_mut() {
@@ -337,6 +359,9 @@ impl Learner {
         s.mean_z.copy_from_slice(&s.z);
         let mut states = 1.0;
         while record.steps < self.rules.max_steps {
+            if cancel.load(Ordering::Relaxed) {
+                return Err(CoreError::Cancelled);
+            }
             let r = match actions.as_deref_mut() {
                 Some(a) => self.step(plant, space, a, s),
                 None => self.step(plant, space, rng, s),
@@ -359,6 +384,9 @@ impl Learner {
         Ok(record)
     }
 }
+
+/// A cancel flag nobody sets.
+static NEVER: AtomicBool = AtomicBool::new(false);
 
 /// `out = z + d`.
 #[inline]

@@ -66,6 +66,9 @@ pub enum CoreError {
         /// How many starts were drawn.
         draws: usize,
     },
+    /// The caller's cancel flag was set during an episode or its start draws (Ctrl-C).
+    #[error("cancelled")]
+    Cancelled,
     /// A configuration value broke its rule ([`crate::params`]), named by its key path.
     #[error(transparent)]
     Param(#[from] crate::params::ParamError),

@@ -162,7 +162,7 @@ pub struct TrialResult {
 /// `template` (weights included, so pre-trained weights carry over), builds its plant with
 /// `make_plant(trial_index)` and runs `options.episodes` episodes in `space`.
 ///
-/// `cancel` is read between episodes: once set, every trial stops and reports
+/// `cancel` is read before every step and start draw: once set, every trial stops and reports
 /// `finished = false`. `done` is incremented after every episode, test episodes included
 /// (progress: `n_trials × (episodes + test_episodes)` in all).
 /// Inputs are checked once, up front; the only error past that point is
@@ -337,9 +337,14 @@ impl<P: Plant> TrialRun<'_, P> {
                 buffer.clear();
                 &mut buffer
             });
-            let rec = self
-                .learner
-                .run_episode_with(plant, space, rng, actions.as_mut(), scratch, path)?;
+            let rec =
+                match self
+                    .learner
+                    .run_episode_with(plant, space, rng, actions.as_mut(), scratch, path, self.cancel)
+                {
+                    Err(CoreError::Cancelled) => return Ok((episodes, trajectories, false)),
+                    other => other?,
+                };
             if let Some(starts) = starts.as_deref_mut() {
                 starts.extend_from_slice(&buffer[..task_dim]);
             }
@@ -501,6 +506,87 @@ mod tests {
         assert!(stopped.finished && stopped.tests.len() == 3);
         assert!(stopped.episodes.len() < 2000 && stopped.episodes.len() % 20 == 0);
         assert_eq!(stopped.episodes[..], full.episodes[..stopped.episodes.len()]);
+    }
+
+    /// A line whose 10th step (or, refusing every start, its 10th start draw) sets the
+    /// caller's cancel flag, as Ctrl-C would.
+    struct Interrupting<'a> {
+        line: Line,
+        calls: &'a AtomicUsize,
+        refuse: bool,
+        cancel: &'a AtomicBool,
+    }
+
+    impl Interrupting<'_> {
+        fn tick(&mut self) {
+            if self.calls.fetch_add(1, Ordering::Relaxed) + 1 == 10 {
+                self.cancel.store(true, Ordering::Relaxed);
+            }
+        }
+    }
+
+    impl Plant for Interrupting<'_> {
+        fn posture_dim(&self) -> usize {
+            1
+        }
+        fn task_dim(&self) -> usize {
+            1
+        }
+        fn sample_start<R: rand::Rng + ?Sized>(&mut self, rng: &mut R, posture: &mut [f64]) {
+            self.line.sample_start(rng, posture);
+        }
+        fn reset(&mut self, posture: &[f64]) -> Option<crate::EndReason> {
+            if self.refuse {
+                self.tick();
+                return Some(crate::EndReason::Obstacle);
+            }
+            self.line.reset(posture)
+        }
+        fn step(&mut self, target: &[f64], reached: &mut [f64]) -> crate::StepOutcome {
+            self.tick();
+            self.line.step(target, reached)
+        }
+        fn task_position(&self, out: &mut [f64]) {
+            self.line.task_position(out);
+        }
+    }
+
+    /// Cancelling inside an episode of 10⁶ steps, or inside 10⁹ start draws, stops the
+    /// trial there (unfinished, no episode recorded), not at the episode's end.
+    #[test]
+    fn cancel_stops_a_trial_inside_an_episode_and_its_start_draws() {
+        let config = crate::LearnerConfig {
+            rbf_per_dim: 11,
+            step: 0.1,
+            ..Default::default()
+        };
+        for refuse in [false, true] {
+            let rules = crate::EpisodeRules {
+                max_steps: 1_000_000,
+                max_start_draws: 1_000_000_000,
+                ..Default::default()
+            };
+            let template = Learner::new(&config, rules, &[0.0], &[1.0]).unwrap();
+            let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
+            let calls = AtomicUsize::new(0);
+            let plant = |_| {
+                Ok(Interrupting {
+                    line: Line { x: 0.0 },
+                    calls: &calls,
+                    refuse,
+                    cancel: &cancel,
+                })
+            };
+            let options = TrialOptions {
+                episodes: 3,
+                ..Default::default()
+            };
+            let trial = run_trials(&template, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
+            let trial = trial.into_iter().next().unwrap();
+            assert!(!trial.finished, "refuse = {refuse}");
+            assert_eq!(calls.load(Ordering::Relaxed), 10, "refuse = {refuse}");
+            assert!(trial.episodes.is_empty() && done.load(Ordering::Relaxed) == 0);
+        }
     }
 
     #[test]

@@ -7,7 +7,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use ::sim::SimError;
 use latent_core::CoreError;
 use pyo3::create_exception;
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
 
 create_exception!(
@@ -82,6 +82,7 @@ pub fn to_py(err: CoreError) -> PyErr {
         | CoreError::Plant { .. }
         | CoreError::TooLarge { .. } => InvalidInputError::new_err(msg),
         CoreError::NotPositiveDefinite { .. } | CoreError::Overflow { .. } => NumericalError::new_err(msg),
+        CoreError::Cancelled => PyKeyboardInterrupt::new_err(msg),
     }
 }
 
