@@ -97,6 +97,22 @@ def test_a_latentrl_train_run_on_a_custom_task_replays(tmp_path):
     assert not (tmp_path / "x.gif").exists()
 
 
+def test_replay_view_3d_draws_the_robot_in_perspective_as_it_moves(runs):
+    """Issue #41: `replay --view 3d` writes frames of the 2-D views' size whose robot panel is
+    not the side view's and changes over the episode (the 3-D artists move in blitted frames)."""
+    videos = {}
+    for view in ("3d", "side"):
+        out = runs / f"lift-{view}.gif"
+        assert main(["replay", str(runs / "exp3"), "--test", "0", "--view", view, "--max-frames", "3",
+                     "--out", str(out)]) == 0
+        videos[view] = iio.imread(out)
+    assert videos["3d"].shape == videos["side"].shape == (3, 480, 960, 3)
+    robot = [_robot_blue(frame[:, :480]) for frame in (*videos["3d"], videos["side"][0])]
+    assert min(mask.sum() for mask in robot[:3]) > 5000  # every frame's solids (its sticks alone: 1800 pixels)
+    assert (robot[0] != robot[3]).sum() > 1000  # not the side view
+    assert (robot[0] != robot[2]).sum() > 1000  # the robot moved (not only the step counter above it)
+
+
 def test_a_training_episode_of_exp1s_latent_learner_becomes_a_gif(runs):
     steps = int(np.load(runs / "exp1" / "returns.npz")["latent_steps"][0, 2])
     out = runs / "toy.gif"
@@ -180,8 +196,105 @@ def test_a_lifting_arm_is_seen_from_the_side_and_its_height_changes_the_picture(
     meshes = [shape for shape in task._native.collision_shapes() if shape["kind"] == "mesh"]
     assert meshes and all(len(shape["points"]) == shape["hull"]["vertices"] for shape in meshes)
     assert all(shape_outline(pose_of[shape["link"]], shape, (0, 2)) is not None for shape in meshes)
-    with pytest.raises(ValueError, match="view must be one of top, side, front"):
-        draw_task(task, plant, view="3d")
+    with pytest.raises(ValueError, match="view must be one of top, side, front, 3d, got 'iso'"):
+        draw_task(task, plant, view="iso")
+
+
+def _arm7_lift():
+    """The test arm (collision meshes on every link) with its target above the start, and two
+    postures whose effector heights differ: bent forward, and lifted at the shoulder."""
+    from pathlib import Path
+
+    from latentrl import Task
+
+    arm7 = Path(__file__).parent / "robots" / "arm7_description" / "urdf" / "arm7.urdf"
+    task = Task.from_dict({"name": "lift", "urdf": str(arm7), "root": "fixed", "effectors": ["tcp"],
+                           "target": {"position": [[0.5, 0.0, 0.9]]}, "floor": {"height": 0.0}})
+    low, high = np.nan_to_num(task.lower, neginf=-1.0), np.nan_to_num(task.upper, posinf=1.0)
+    bent = np.clip(np.array([0.0, 0.9, 0.0, -1.5, 0.0, 1.8, 0.0, 0.0, 0.0][: len(low)]), low, high)
+    raised = bent.copy()
+    raised[1] = np.clip(0.2, low[1], high[1])
+    return task, (bent, raised)
+
+
+def _draw_3d(scene, poses, limits):
+    """The 3d view of `scene` at link poses `poses` within `limits`, and a function from world
+    points to the (row, column) of their pixel in it."""
+    from mpl_toolkits.mplot3d import proj3d
+
+    from latentrl.render import _canvas, _pixels, draw_scene
+
+    fig, ax = _canvas(200, scene.view)
+    draw_scene(ax, scene, poses, limits)
+    image = _pixels(fig)
+
+    def pixel(point):
+        x, y, _ = proj3d.proj_transform(*point, ax.get_proj())
+        column, up = ax.transData.transform((x, y))
+        return image.shape[0] - int(round(up)), int(round(column))
+
+    return image, pixel
+
+
+def _robot_blue(image):
+    """Where `image` (..., 3) has the robot's colour (C0, blue over the light panes): blue well
+    above red (the target is green, obstacles, floor, panes and text grey)."""
+    return image[..., 2].astype(int) - image[..., 0] > 60
+
+
+def test_the_3d_view_shows_a_lift_of_the_effector_in_the_drawing_size():
+    """Issue #41: in the 3d view (mplot3d, the same image size as the 2-D views) an arm lifting
+    its effector toward a target above it is drawn higher: the pixels around the effector change,
+    the robot is drawn at its effector in both postures, and the lifted one sits higher."""
+    from latentrl.render import VIEWS, Scene, draw_task, scene_limits
+
+    task, postures = _arm7_lift()
+    plant = task.plant()
+    poses, heights = [], []
+    for posture in postures:
+        assert plant.reset(posture) is None
+        poses.append(np.asarray(plant.link_poses()))
+        heights.append(float(plant.effectors()[2]))
+    assert heights[1] - heights[0] > 0.05
+    assert draw_task(task, plant, size=200, view="3d").shape == draw_task(task, plant, size=200, view="side").shape
+    scene = Scene.of(task, plant, np.concatenate(poses)[:, :3], "3d")
+    assert scene.view == VIEWS["3d"] == (0, 1, 2)
+    limits = scene_limits(scene, np.concatenate(poses)[:, :3])  # one frame for both, as a replay draws
+    drawn = [_draw_3d(scene, pose, limits) for pose in poses]
+    tcp = task.link_names.index("tcp")
+    where = [pixel(pose[tcp, :3]) for (_, pixel), pose in zip(drawn, poses)]
+    assert where[1][0] < where[0][0] - 5  # the lifted effector is higher in the picture
+    for (image, _), (row, column) in zip(drawn, where):
+        assert _robot_blue(image[row - 3: row + 4, column - 3: column + 4]).sum() > 5
+    bent, raised = (image.astype(int) for image, _ in drawn)
+    for row, column in where:
+        window = np.s_[row - 3: row + 4, column - 3: column + 4]
+        assert np.abs(bent[window] - raised[window]).sum() > 1000
+
+
+def test_the_3d_view_draws_a_mesh_link_as_its_hull():
+    """Issue #41: a link whose collision shape is a mesh is drawn in the 3d view as the hull the
+    physics collides with: without the kinematic tree's sticks, the pixels where the link is
+    are the robot's, and they are background when the shape is left out."""
+    from dataclasses import replace
+
+    from latentrl.render import Scene, scene_limits, shape_points
+
+    task, (bent, _) = _arm7_lift()
+    plant = task.plant()
+    assert plant.reset(bent) is None
+    poses = np.asarray(plant.link_poses())
+    scene = replace(Scene.of(task, plant, poses[:, :3], "3d"), edges=())
+    limits = scene_limits(scene, poses[:, :3])
+    link4 = [shape for shape in scene.shapes if shape["link"] == "link4"]
+    assert [shape["kind"] for shape in link4] == ["mesh"]
+    centre = shape_points(poses[task.link_names.index("link4")], link4[0]).mean(axis=0)
+    with_mesh, pixel = _draw_3d(scene, poses, limits)
+    without, _ = _draw_3d(replace(scene, shapes=tuple(s for s in scene.shapes if s["link"] != "link4")), poses, limits)
+    row, column = pixel(centre)
+    window = np.s_[row - 2: row + 3, column - 2: column + 3]
+    assert _robot_blue(with_mesh[window]).all()
+    assert not _robot_blue(without[window]).any()
 
 
 STREAM = """

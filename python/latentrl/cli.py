@@ -23,6 +23,7 @@ from latentrl.experiments.presets import field_docs, with_overrides
 from latentrl.experiments.registry import experiments, task_schema
 from latentrl.experiments.results import environment, read_json, write_json
 from latentrl.recorded.options import DemoOptions
+from latentrl.render import CAMERA, VIEWS
 from latentrl.run_lock import run_lock
 from latentrl.task import by_path, changed_since
 from latentrl.train import POLICIES, format_rollout
@@ -232,9 +233,10 @@ def build_parser() -> argparse.ArgumentParser:
     replay.add_argument("--max-frames", type=int, default=400, help="at most this many frames, evenly spaced over the episode (default 400)")
     replay.add_argument("--policy", choices=POLICIES, default="greedy",
                         help="of a rollout directory: which policy's episode (default: greedy)")
-    replay.add_argument("--view", choices=("top", "side", "front"),
-                        help="the robot seen from the top (x-y), the side (x-z) or the front (y-z); default: the side of a "
-                             "floating robot, else the plane its links and target spread over most")
+    replay.add_argument("--view", choices=tuple(VIEWS),
+                        help="the robot seen from the top (x-y), the side (x-z), the front (y-z) or in 3d (perspective, "
+                             f"elevation {CAMERA[0]:g}°, azimuth {CAMERA[1]:g}°); default: the side of a floating robot, "
+                             "else the plane its links and target spread over most")
     urdf = sub.add_parser("urdf-info", help="what a URDF holds as the physics loads it: joints, links, collision shapes, mass")
     urdf.add_argument("urdf", type=Path, help="the robot's URDF file")
     urdf.add_argument("--json", action="store_true", help="print it as JSON instead of a table")

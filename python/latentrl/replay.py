@@ -134,11 +134,12 @@ def iter_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_frame
     from matplotlib.figure import Figure
 
     from latentrl.plots import latent_value_panel
-    from latentrl.render import RobotArtists, draw_backdrop, draw_toy_backdrop, view_limits
+    from latentrl.render import RobotArtists, draw_backdrop, draw_toy_backdrop, scene_limits, view_subplot
 
     fig = Figure(figsize=(size[0] / 100, size[1] / 100), dpi=100)
     canvas = FigureCanvasAgg(fig)
-    left, value = fig.add_subplot(1, 2, 1, aspect="equal"), fig.add_subplot(1, 2, 2)
+    left = view_subplot(fig, VIEWS["top"] if episode.poses is None else episode.scene.view, 1, 2, 1)
+    value = fig.add_subplot(1, 2, 2)
     latent_value_panel(value, episode.weights, episode.low, episode.high, episode.model, learner=episode.learner,
                        grid=60)
     trace, = value.plot([], [], "-", color="w", lw=1.5, animated=True)
@@ -147,9 +148,8 @@ def iter_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_frame
     label.set_animated(True)
     if episode.poses is not None:
         scene = episode.scene
-        every = episode.poses[..., :3].reshape(-1, 3)[:, list(scene.view)]
-        draw_backdrop(left, scene, view_limits(every[np.isfinite(every).all(axis=1)]))  # one view for the episode
-        robot = RobotArtists(left, scene, animated=True)
+        draw_backdrop(left, scene, scene_limits(scene, episode.poses[..., :3].reshape(-1, 3)))  # one view for the episode
+        robot = RobotArtists.of(left, scene, animated=True)
         moving = [*robot.artists, trace, point, label]
 
         def move(step: int) -> None:
