@@ -157,6 +157,13 @@ def test_a_policy_file_is_checked(arms_model: GPLVM, tmp_path: Path) -> None:
     np.savez(tmp_path / "edited.npz", **arrays)
     with pytest.raises(ValueError, match="its task .* changed since it was saved"):
         LatentPolicy.load(tmp_path / "edited.npz")
+    # Issue #38: a newer format, weights or a record of the wrong shape, NaN demos: refused, naming the file.
+    edits = {"format_version": np.array(99), "weights": arrays["weights"][..., :3],
+             "demos": np.full_like(arrays["demos"], np.nan), "record.returns": arrays["record.returns"].ravel()}
+    for key, value in edits.items():
+        np.savez(tmp_path / f"{key}.npz", **{**dict(np.load(tmp_path / "policy.npz")), key: value})
+        with pytest.raises(ValueError, match=rf"^{re.escape(str(tmp_path / key))}\.npz: .*(99|weights|demos|record)"):
+            LatentPolicy.load(tmp_path / f"{key}.npz")
 
 
 def test_humanoid_task_runs() -> None:

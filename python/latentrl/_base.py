@@ -12,7 +12,7 @@ import uuid
 import warnings
 import zipfile
 import zlib
-from collections.abc import Callable, Collection, Iterator, Sequence
+from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, ClassVar, Self
@@ -408,27 +408,26 @@ class Estimator:
     def _from_arrays(cls, arrays: dict[str, Any], path: str) -> Self:
         """The estimator of `_arrays`' output; `path` names it in errors."""
         expected = f"latentrl.{cls.__name__}"
-        found = str(arrays["format"]) if "format" in arrays else None
-        if found != expected:
-            raise ValueError(f"{path}: holds {found or 'no latentrl model'}, expected {expected}")
-        version = arrays.get("format_version")
-        if (
-            version is None
-            or version.ndim != 0
-            or version.dtype.kind != "i"
-            or int(version) != FORMAT_VERSION
-        ):
-            shown = "missing" if version is None else f"{version.tolist()!r} ({version.dtype})"
-            raise ValueError(
-                f"{path}: format_version {shown} is not supported "
-                f"(this latentrl reads the integer {FORMAT_VERSION})"
-            )
+        check_format(arrays, expected, path)
         try:
             estimator = cls(**json.loads(str(arrays["params"])))
             estimator._restore(arrays)
         except (KeyError, TypeError, ValueError) as err:
             raise ValueError(f"{path}: inconsistent {expected} file: {err}") from err
         return estimator
+
+
+def check_format(arrays: Mapping[str, Any], expected: str, path: str) -> None:
+    """ValueError naming `path` unless `arrays` (a saved file's) hold the format `expected` (e.g.
+    "latentrl.GPLVM") at this latentrl's `FORMAT_VERSION`."""
+    found = str(arrays["format"]) if "format" in arrays else None
+    if found != expected:
+        raise ValueError(f"{path}: holds {found or 'no latentrl file'}, expected {expected}")
+    version = arrays.get("format_version")
+    if version is None or version.ndim != 0 or version.dtype.kind != "i" or int(version) != FORMAT_VERSION:
+        shown = "missing" if version is None else f"{version.tolist()!r} ({version.dtype})"
+        raise ValueError(f"{path}: format_version {shown} is not supported (this latentrl reads the integer "
+                         f"{FORMAT_VERSION})")
 
 
 def initial_log_theta(

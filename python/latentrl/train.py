@@ -23,13 +23,10 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from latentrl.progress import progress_bar
 
 from latentrl import _native
-from latentrl._base import FORMAT_VERSION, PathLike, atomic_write, read_npz
-from latentrl.experiments.latent_runs import task_learner
+from latentrl._base import FORMAT_VERSION, PathLike, atomic_write, check_format, read_npz
 from latentrl.experiments.presets import LatentRun, latent_box, with_overrides
-from latentrl.experiments.runner import Setup, end_counts, episodes_per_trial, run_in_process
 from latentrl.gplvm import GPLVM
 from latentrl.task import SHIPPED, Task, end_reasons
 
@@ -100,6 +97,10 @@ def train_latent_policy(
     box of ``model.Z_`` widened by ``latent_margin``. Ctrl-C stops the run with
     `KeyboardInterrupt`.
     """
+    from latentrl.experiments.latent_runs import task_learner  # the runner and tqdm: at the first run
+    from latentrl.experiments.runner import Setup, episodes_per_trial, run_in_process
+    from latentrl.progress import progress_bar
+
     if preset not in ("quick", "paper"):
         raise ValueError(f"preset must be 'quick' or 'paper', got {preset!r}")
     if not isinstance(model, GPLVM) or not hasattr(model, "decoder_"):
@@ -136,6 +137,8 @@ def rollout_summary(ends: NDArray[Any], reached: NDArray[Any], returns: NDArray[
     """What rollout episodes of `task` did: "success" (the share that ended as the task's
     success, `target.hold_steps`; None where the task has no such rule), "reached_any_step" (the
     share within the reach radius after some step), the count of each ending, the mean return."""
+    from latentrl.experiments.runner import end_counts
+
     rule = task.to_dict()["target"]["hold_steps"] > 0
     return {
         "success": float((ends == end_reasons().index("success")).mean()) if rule else None,
@@ -174,7 +177,11 @@ class LatentPolicy:
         preset: Any = None,
         record: Mapping[str, NDArray[Any]] | None = None,
     ) -> None:
-        self.task, self.model, self.demos = task, model, demos
+        self.task, self.model, self.demos = task, model, np.asarray(demos, dtype=np.float64)
+        joints = len(task.joint_names)
+        if self.demos.ndim != 2 or self.demos.shape[1] != joints or not np.isfinite(self.demos).all():
+            raise ValueError(f"demos: expected finite postures of shape (N, {joints}), got shape {self.demos.shape}"
+                             + ("" if np.isfinite(self.demos).all() else " with NaN or infinite values"))
         self.latent_low, self.latent_high = np.asarray(latent_low), np.asarray(latent_high)
         self.weights = np.asarray(weights, dtype=np.float64)
         """(trials, rbf_per_dim^d) final TD(0) weights of V; with `learner.move_correction`
@@ -184,6 +191,12 @@ class LatentPolicy:
         self.record = dict(record or {})
         """Per training episode: returns, ends (codes of `end_reasons()`), reached; the same for
         the frozen test episodes (`test_*`); each (trials, episodes)."""
+        for name, values in self.record.items():
+            if name not in RECORD:
+                raise ValueError(f"record.{name}: not one of {list(RECORD)}")
+            if np.ndim(values) != 2 or len(values) != len(self.weights):
+                raise ValueError(f"record.{name}: expected (trials, episodes) with {len(self.weights)} trials, "
+                                 f"got shape {np.shape(values)}")
         learner = task.to_dict()["learner"]
         self._native = [
             _native.LatentPolicy(learner, list(self.latent_low), list(self.latent_high), w, model.decoder_, model.loop_encoder_)
@@ -284,9 +297,7 @@ class LatentPolicy:
             arrays = read_npz(path)
         except ValueError as err:
             raise ValueError(f"{path}: {err}") from err
-        found = str(arrays["format"]) if "format" in arrays else None
-        if found != "latentrl.LatentPolicy":
-            raise ValueError(f"{path}: holds {found or 'no latentrl file'}, expected latentrl.LatentPolicy")
+        check_format(arrays, "latentrl.LatentPolicy", str(path))
         missing = [k for k in ("task", "task_dir", "task_digest", "latent_low", "latent_high", "weights", "demos")
                    if k not in arrays]
         if missing:
@@ -296,8 +307,11 @@ class LatentPolicy:
             raise ValueError(f"{path}: its task (or the task's URDF in {arrays['task_dir']}) changed since it was saved")
         model = GPLVM._from_arrays({k[6:]: v for k, v in arrays.items() if k.startswith("model.")}, str(path))
         record = {k[7:]: v for k, v in arrays.items() if k.startswith("record.")}
-        return cls(task=task, model=model, demos=arrays["demos"], latent_low=arrays["latent_low"],
-                   latent_high=arrays["latent_high"], weights=arrays["weights"], record=record)
+        try:
+            return cls(task=task, model=model, demos=arrays["demos"], latent_low=arrays["latent_low"],
+                       latent_high=arrays["latent_high"], weights=arrays["weights"], record=record)
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"{path}: {err}") from err
 
     def __repr__(self) -> str:
         return f"LatentPolicy({self.task.name!r}, {len(self.weights)} trials, latent box {len(self.latent_low)}-D)"
