@@ -142,6 +142,28 @@ def test_settings_are_derived_where_the_task_is_silent(glass):
                   set(task.given) | {"learner.step", "learner.initial_weight", "episode.stop_window"}) == []
 
 
+def test_the_step_keeps_the_path_within_half_an_episode():
+    """`derive.learner_step`: the largest step whose target region spans ≥ 3 steps, unless 95 % of
+    starts then need more than half the episode — then the smallest step whose paths fit (the
+    zoo's 7-DoF arms: a region spanning 3 steps only at 1/8 spacing, 158–164 moves of 200)."""
+    from latentrl.derive import learner_step
+
+    def surveys(spans: dict[float, float], moves: dict[float, int]):
+        def at(step: float) -> dict:
+            reached = round(spans[step] ** 2)  # _span: the side of a square of reached points, stride 1
+            return {"reached": np.ones(reached, bool), "shape": (10, 10), "stride": 1,
+                    "moves": np.full(20, moves[step])}
+        return at
+
+    spans = {1.0: 0.0, 0.5: 1.0, 0.25: 2.2, 0.125: 4.5, 0.0625: 8.5}
+    moves = {1.0: 20, 0.5: 41, 0.25: 82, 0.125: 164, 0.0625: 330}
+    step, _, rule = learner_step(surveys(spans, moves), budget=200)
+    assert step == 0.25 and "82 moves" in rule and "would be 0.125" in rule
+    assert learner_step(surveys(spans, moves), budget=1000)[0] == 0.125  # room to spare: the span rule
+    assert learner_step(surveys(spans, dict.fromkeys(moves, 10000)), budget=200)[0] == 0.125  # nothing fits: span
+    assert learner_step(surveys(dict.fromkeys(spans, 0.0), moves), budget=200) is None
+
+
 def test_servo_gains_are_derived_where_the_task_is_silent():
     """Issue #37: the zoo's Panda-style arm without its [servo] table. The default gains (kp 5000,
     kd 50) leave its effector 22 mm off the demo postures (the stock Panda's wrist oscillated

@@ -14,7 +14,9 @@ The rules (docs/tasks.md, "Settings derived from the data"):
   unvisited states look worth visiting (the quick presets' choice, made a rule);
 - `learner.step`: the largest of 1, 1/2, 1/4, 1/8, 1/16 RBF spacings at which the target region
   (admissible latent points within `target.reach_radius`, `latentrl check`'s survey) spans at
-  least `SPAN` steps across, so a move can land inside it and stay;
+  least `SPAN` steps across, so a move can land inside it and stay — unless 95 % of the starts
+  would then need more than 1/`FIT` of `episode.max_steps` moves to reach it: then the smallest
+  step at which they need at most that (reaching the target first, landing in it second);
 - `episode.max_steps` = `SLACK` × the moves that 95 % of admissible starts need to the target at
   that step (at least `MIN_STEPS`, at most the schema's default);
 - `episode.stop_window` = `STOP_WINDOW`: a trial stops once 3 windows of that many episodes in a
@@ -25,6 +27,7 @@ The rules (docs/tasks.md, "Settings derived from the data"):
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,6 +42,11 @@ STEPS = (1.0, 0.5, 0.25, 0.125, 0.0625)
 
 SPAN = 3.0
 """Learner steps the target region must span across (the side of a square of its points)."""
+
+FIT = 2
+"""An episode holds at least this many times the moves 95 % of starts need at the learner's step:
+a step so small that the path fills the episode leaves no room to explore (the zoo's 7-DoF arms
+at 1/8 RBF spacing needed 158–164 of their 200 steps and never learnt; at 1/4, 79–82)."""
 
 SLACK = 3
 """Episode length over the moves 95 % of starts need at rest: room to explore and to hold."""
@@ -89,21 +97,16 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
     step = config["learner"]["step"]
     survey = None
     if "learner.step" not in given:
-        for candidate in STEPS:
-            found = _survey(task.replace({"learner.step": candidate}), model, low, high, demos)
-            span = _span(found)
-            if span >= SPAN:
-                step, survey = candidate, found
-                out.append(Derived("learner.step", step, f"the largest of {', '.join(f'{s:g}' for s in STEPS)} RBF "
-                                                         f"spacings at which the target region spans ≥ {SPAN:g} steps "
-                                                         f"(it spans {span:.1f})"))
-                break
+        budget = config["episode"]["max_steps"] if "episode.max_steps" in given else _default("episode.max_steps")
+        found = learner_step(lambda s: _survey(task.replace({"learner.step": s}), model, low, high, demos), budget)
+        if found is not None:
+            step, survey, rule = found
+            out.append(Derived("learner.step", step, rule))
     if "episode.max_steps" not in given:
         survey = survey or _survey(task.replace({"learner.step": step}), model, low, high, demos)
-        moves = survey["moves"][survey["moves"] >= 0]
-        if len(moves):
+        needed = _moves95(survey)
+        if needed is not None:
             default = _default("episode.max_steps")
-            needed = int(np.percentile(moves, 95))
             value = int(min(default, max(MIN_STEPS, SLACK * needed)))
             out.append(Derived("episode.max_steps", value, f"{SLACK} × the {needed} moves 95 % of admissible starts "
                                                            f"need to the target at rest (in [{MIN_STEPS}, {default}])"))
@@ -112,6 +115,30 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
                            f"stop a trial after {config['episode']['stop_patience']} windows of {STOP_WINDOW} episodes "
                            "in a row without a higher reach count or a mean return 1 % higher (the budget is a ceiling)"))
     return out
+
+
+def learner_step(survey_at: Callable[[float], dict[str, Any]], budget: int) -> tuple[float, dict[str, Any], str] | None:
+    """`learner.step` (module docs): the largest of `STEPS` at which the target region spans
+    `SPAN` steps, unless 95 % of the starts then need more than `budget` / `FIT` moves — then the
+    smallest step at which they need at most that, if any; with its survey (`survey_at(step)`)
+    and rule. None if the target region spans `SPAN` steps at no candidate."""
+    spans = f"the largest of {', '.join(f'{s:g}' for s in STEPS)} RBF spacings at which the target region spans ≥ {SPAN:g} steps"
+    fitting = None
+    for candidate in STEPS:
+        found = survey_at(candidate)
+        span, moves = _span(found), _moves95(found)
+        fits = moves is not None and FIT * moves <= budget
+        if fits:
+            fitting = (candidate, found, span, moves)
+        if span < SPAN:
+            continue
+        if fits or fitting is None:
+            return candidate, found, f"{spans} (it spans {span:.1f})"
+        step, found, span, moves = fitting
+        return step, found, (f"{spans} would be {candidate:g}, where 95 % of the starts need more than 1/{FIT:g} of "
+                             f"an episode's {budget} steps to reach it: the smallest step at which they need at most "
+                             f"that ({moves} moves; the region spans {span:.1f} steps)")
+    return None
 
 
 def servo_gains(task: Task, demos: NDArray[np.float64]) -> list[Derived]:
@@ -152,6 +179,13 @@ def _default(key: str) -> Any:
 def _survey(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.float64],
             demos: NDArray[np.float64]) -> dict[str, Any]:
     return _native.latent_survey(task._native, decoder=model.decoder_, latent_low=low, latent_high=high, demos=demos)
+
+
+def _moves95(survey: dict[str, Any]) -> int | None:
+    """The moves to the target that 95 % of the admissible starts with a path need (None: no path)."""
+    moves = np.asarray(survey["moves"])
+    moves = moves[moves >= 0]
+    return int(np.percentile(moves, 95)) if len(moves) else None
 
 
 def _span(survey: dict[str, Any]) -> float:
