@@ -48,14 +48,16 @@ def figures(run: TrainRun, arrays: Mapping[str, np.ndarray], run_dir: Path, out:
 
 def failures(arrays: Mapping[str, np.ndarray], name: str, low: np.ndarray, high: np.ndarray, model: Any,
              learner: Mapping[str, Any], out: Path) -> None:
-    """`failures.png`: trial 0's V after learning with, for each episode of the last fifth of
-    training that never came within the reach radius, its mean latent state, coloured by how it
+    """`failures.png`: trial 0's V after learning with, for each episode of the last fifth of the
+    episodes it ran that never came within the reach radius, its mean latent state, coloured by how it
     ended (where in the latent space episodes fail)."""
     trial = 0
-    fifth = max(1, arrays["latent"].shape[1] // 5)
-    means = np.asarray(arrays["latent_mean_state"])[trial, -fifth:]
-    ends = np.asarray(arrays["latent_end"])[trial, -fifth:]
-    failed = ~np.asarray(arrays["latent_reached"], dtype=bool)[trial, -fifth:] & np.isfinite(means).all(axis=1)
+    ran = int((np.asarray(arrays["latent_end"])[trial] >= 0).sum())  # a stopped trial ran fewer than its budget
+    fifth = max(1, ran // 5)
+    last = slice(ran - fifth, ran)
+    means = np.asarray(arrays["latent_mean_state"])[trial, last]
+    ends = np.asarray(arrays["latent_end"])[trial, last]
+    failed = ~np.asarray(arrays["latent_reached"], dtype=bool)[trial, last] & np.isfinite(means).all(axis=1)
     fig, ax = plt.subplots(figsize=(6, 5))
     latent_value_panel(ax, np.asarray(arrays["latent_weights"])[trial], low, high, model, learner=learner)
     for code, reason in enumerate(end_reasons()):
