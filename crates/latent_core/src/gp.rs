@@ -1,5 +1,6 @@
 //! A fitted GP regression map (paper Eq. 4): the GPLVM decoder (latent → posture) and the
-//! out-of-sample encoder (posture → latent) are both a [`GpMap`].
+//! out-of-sample encoder (posture → latent) are both a [`GpMap`], and so is the sparse GPLVM's
+//! DTC decoder (`GpMap::sparse`, in [`crate::sparse_gplvm`]): its inputs are the inducing inputs.
 //!
 //! Points are the columns of a matrix: a NumPy `(N, q)` C-ordered array read as
 //! column-major `q×N` is exactly that, with no copy.
@@ -11,7 +12,9 @@ use crate::error::{CoreError, Result, check_finite};
 use crate::kernel::{SeKernel, factorize};
 
 /// Predictive mean and variance of a GP fitted to (inputs, outputs), everything that can be
-/// pre-computed done once: the Cholesky factor `L` of `K` and `α = K⁻¹ (Y − mean)`.
+/// pre-computed done once: the Cholesky factor `L` of `K` and `α = K⁻¹ (Y − mean)`. The mean at
+/// `x` is `k(x, inputs) α + mean`, the variance `k(x, x) − k*ᵀ M k*` with `M = K⁻¹`, or for a
+/// sparse (DTC) map `M = K_mm⁻¹ − (K_mm + K_mn K_nm/θ3)⁻¹` over its inducing inputs.
 #[derive(Debug, Clone)]
 pub struct GpMap {
     pub(crate) kernel: SeKernel,
@@ -19,11 +22,13 @@ pub struct GpMap {
     pub(crate) inputs: DMatrix<f64>,
     /// `αᵀ` (p×N), so the mean is one matrix–vector product.
     pub(crate) alpha_t: DMatrix<f64>,
-    /// Cholesky factor of `K` (jitter included).
+    /// Cholesky factor of `K` (jitter included; `K_mm`'s for a sparse map).
     pub(crate) lower: DMatrix<f64>,
+    /// A sparse map's Cholesky factor of `K_mm + K_mn K_nm/θ3`, whose inverse `M` subtracts.
+    pub(crate) projected: Option<DMatrix<f64>>,
     /// Output mean (p).
     pub(crate) mean: DVector<f64>,
-    jitter: f64,
+    pub(crate) jitter: f64,
 }
 
 /// The most points a GP map or the GPLVM objective takes: its dense N×N kernel matrix is then
@@ -46,11 +51,16 @@ pub(crate) fn check_gp_size(what: &'static str, n: usize) -> Result<()> {
 /// The training inputs (q×N) and per-point values (p×N, called `what`) of a map: not empty, at
 /// most [`MAX_GP_POINTS`], one value column per input, all finite.
 fn check_training(inputs: &DMatrix<f64>, values: &DMatrix<f64>, what: &'static str) -> Result<()> {
+    check_gp_size("inputs", inputs.ncols())?;
+    check_values(inputs, values, what)
+}
+
+/// [`check_training`] without the size limit (a sparse map's training set has none).
+pub(crate) fn check_values(inputs: &DMatrix<f64>, values: &DMatrix<f64>, what: &'static str) -> Result<()> {
     let n = inputs.ncols();
     if n == 0 || inputs.nrows() == 0 {
         return Err(CoreError::Empty { what: "inputs" });
     }
-    check_gp_size("inputs", n)?;
     if values.ncols() != n || values.nrows() == 0 {
         return Err(CoreError::Shape {
             what,
@@ -62,11 +72,35 @@ fn check_training(inputs: &DMatrix<f64>, values: &DMatrix<f64>, what: &'static s
     check_finite(what, values.as_slice())
 }
 
+/// [`CoreError`] unless `points` (dim×M, named `what`) are of dimension `dim` and finite.
+pub(crate) fn check_points(what: &'static str, points: &DMatrix<f64>, dim: usize) -> Result<()> {
+    if points.nrows() != dim {
+        return Err(CoreError::Shape {
+            what,
+            expected: format!("(M, {dim})"),
+            got: format!("({}, {})", points.ncols(), points.nrows()),
+        });
+    }
+    check_finite(what, points.as_slice())
+}
+
 /// Reusable buffers for [`GpMap::predict_into`], so a prediction allocates nothing.
 #[derive(Debug, Clone)]
 pub struct PredictScratch {
     kstar: DVector<f64>,
     solved: DVector<f64>,
+    spare: DVector<f64>,
+}
+
+/// `‖L⁻¹ v‖²` for a lower-triangular `L`, with `L⁻¹ v` left in `out`, or `L⁻ᵀ L⁻¹ v` if `back`.
+fn solve_norm(lower: &DMatrix<f64>, v: &DVector<f64>, out: &mut DVector<f64>, back: bool) -> f64 {
+    out.copy_from(v);
+    lower.solve_lower_triangular_mut(out);
+    let norm = out.norm_squared();
+    if back {
+        lower.tr_solve_lower_triangular_mut(out);
+    }
+    norm
 }
 
 impl GpMap {
@@ -91,6 +125,7 @@ impl GpMap {
             inputs,
             alpha_t,
             lower: factor.cholesky.l(),
+            projected: None,
             mean,
             jitter: factor.jitter,
         })
@@ -108,8 +143,29 @@ impl GpMap {
             alpha_t: weights,
             inputs,
             lower: factor.cholesky.l(),
+            projected: None,
             jitter: factor.jitter,
         })
+    }
+
+    /// `k*ᵀ M k*`, the prior variance the inputs explain at a point whose `k*` is `kstar`; with
+    /// `weights`, leaves `M k*` in `solved` (the variance's gradient is `−2 (M k*)ᵀ ∂k*/∂x`).
+    /// `solved` and `spare` are buffers of the inputs' length.
+    pub(crate) fn explained(
+        &self,
+        kstar: &DVector<f64>,
+        solved: &mut DVector<f64>,
+        spare: &mut DVector<f64>,
+        weights: bool,
+    ) -> f64 {
+        let mut explained = solve_norm(&self.lower, kstar, solved, weights);
+        if let Some(projected) = &self.projected {
+            explained -= solve_norm(projected, kstar, spare, weights);
+            if weights {
+                *solved -= &*spare;
+            }
+        }
+        explained
     }
 
     /// Input dimension q.
@@ -147,6 +203,7 @@ impl GpMap {
         PredictScratch {
             kstar: DVector::zeros(self.len()),
             solved: DVector::zeros(self.len()),
+            spare: DVector::zeros(self.len()),
         }
     }
 
@@ -156,9 +213,8 @@ impl GpMap {
     /// contract (checked in debug builds).
     pub fn predict_into(&self, x: &[f64], mean_out: &mut [f64], scratch: &mut PredictScratch) -> f64 {
         self.mean_into(x, mean_out, scratch);
-        scratch.solved.copy_from(&scratch.kstar);
-        self.lower.solve_lower_triangular_mut(&mut scratch.solved);
-        (self.kernel.prior_variance() - scratch.solved.norm_squared()).max(0.0)
+        let explained = self.explained(&scratch.kstar, &mut scratch.solved, &mut scratch.spare, false);
+        (self.kernel.prior_variance() - explained).max(0.0)
     }
 
     /// The mean half of [`Self::predict_into`]: `O(N (q + p))`, leaves `k*` in `scratch`.
@@ -175,14 +231,7 @@ impl GpMap {
 
     /// Checks a batch of query points (q×M) before prediction.
     pub fn check_queries(&self, queries: &DMatrix<f64>) -> Result<()> {
-        if queries.nrows() != self.input_dim() {
-            return Err(CoreError::Shape {
-                what: "query points",
-                expected: format!("(M, {})", self.input_dim()),
-                got: format!("({}, {})", queries.ncols(), queries.nrows()),
-            });
-        }
-        check_finite("query points", queries.as_slice())
+        check_points("query points", queries, self.input_dim())
     }
 
     /// Means (p×M) and variances (M) at the columns of `queries` (q×M), points in parallel.

@@ -59,6 +59,61 @@ impl SeKernel {
         }
         k
     }
+
+    /// The smooth part only, `se(a_i, b_j)`, between the columns of `a` (q×n) and `b` (q×m): n×m.
+    pub fn cross(&self, a: &DMatrix<f64>, b: &DMatrix<f64>) -> DMatrix<f64> {
+        DMatrix::from_fn(a.ncols(), b.ncols(), |i, j| {
+            self.se(a.column(i).as_slice(), b.column(j).as_slice())
+        })
+    }
+
+    /// Chain rule through the smooth part: given `se` = [`Self::cross`]`(a, b)` and `g = ∂L/∂se`
+    /// (n×m, every entry an independent variable), the gradient of `L` with respect to the
+    /// points `a` and `b` and to `log θ1`, `log θ2`, using
+    /// `∂se_ij/∂a_i = −se_ij (a_i − b_j)/θ2 = −∂se_ij/∂b_j`, `∂se_ij/∂log θ1 = se_ij` and
+    /// `∂se_ij/∂log θ2 = se_ij ‖a_i − b_j‖²/(2 θ2)`. For `a = b` the points' gradient is `a + b`.
+    pub fn se_grad(&self, a: &DMatrix<f64>, b: &DMatrix<f64>, se: &DMatrix<f64>, g: &DMatrix<f64>) -> SeGrad {
+        let q = a.nrows();
+        let mut grad = SeGrad {
+            a: DMatrix::zeros(q, a.ncols()),
+            b: DMatrix::zeros(q, b.ncols()),
+            log_variance: 0.0,
+            log_lengthscale_sq: 0.0,
+        };
+        for j in 0..b.ncols() {
+            let bj = b.column(j);
+            for i in 0..a.ncols() {
+                let gse = g[(i, j)] * se[(i, j)];
+                if gse == 0.0 {
+                    continue;
+                }
+                let coeff = -gse / self.lengthscale_sq;
+                let mut r2 = 0.0;
+                for c in 0..q {
+                    let diff = a[(c, i)] - bj[c];
+                    r2 += diff * diff;
+                    grad.a[(c, i)] += coeff * diff;
+                    grad.b[(c, j)] -= coeff * diff;
+                }
+                grad.log_variance += gse;
+                grad.log_lengthscale_sq += gse * r2 / (2.0 * self.lengthscale_sq);
+            }
+        }
+        grad
+    }
+}
+
+/// [`SeKernel::se_grad`]: the gradient of a scalar through the smooth part of a kernel matrix.
+#[derive(Debug, Clone)]
+pub struct SeGrad {
+    /// With respect to the first points (q×n).
+    pub a: DMatrix<f64>,
+    /// With respect to the second points (q×m).
+    pub b: DMatrix<f64>,
+    /// With respect to `log θ1`.
+    pub log_variance: f64,
+    /// With respect to `log θ2`.
+    pub log_lengthscale_sq: f64,
 }
 
 /// A Cholesky factor together with the jitter that had to be added to get it.

@@ -58,6 +58,7 @@ pub struct Projection {
 struct DecodeScratch {
     kstar: DVector<f64>,
     solved: DVector<f64>,
+    spare: DVector<f64>,
     /// `∂k*/∂z` (N×d).
     dk: DMatrix<f64>,
     mean: DVector<f64>,
@@ -144,6 +145,7 @@ impl Projection {
             decode: DecodeScratch {
                 kstar: DVector::zeros(n),
                 solved: DVector::zeros(n),
+                spare: DVector::zeros(n),
                 dk: DMatrix::zeros(n, d),
                 mean: DVector::zeros(joints),
                 jac: DMatrix::zeros(joints, d),
@@ -286,8 +288,9 @@ impl Projection {
     }
 
     /// Eq. 4 at `z` with gradients: the mean into `s.mean`, its Jacobian `αᵀ ∂k*/∂z` into
-    /// `s.jac`; with `with_variance`, returns `σ² = k(z, z) − k*ᵀK⁻¹k*` (unclamped, as the
-    /// reference) and writes `∂σ²/∂z = −2 (K⁻¹k*)ᵀ ∂k*/∂z` into `s.d_variance` (else returns 0).
+    /// `s.jac`; with `with_variance`, returns `σ² = k(z, z) − k*ᵀMk*` (`M = K⁻¹`, or a sparse
+    /// map's; unclamped, as the reference) and writes `∂σ²/∂z = −2 (Mk*)ᵀ ∂k*/∂z` into
+    /// `s.d_variance` (else returns 0).
     /// `∂k*_i/∂z = −k*_i (z − z_i) / θ2` (Eq. 2).
     fn decode(&self, z: &[f64], s: &mut DecodeScratch, with_variance: bool) -> f64 {
         let map = &self.decoder;
@@ -305,10 +308,7 @@ impl Projection {
         if !with_variance {
             return 0.0;
         }
-        s.solved.copy_from(&s.kstar);
-        map.lower.solve_lower_triangular_mut(&mut s.solved);
-        let variance = map.kernel.prior_variance() - s.solved.norm_squared();
-        map.lower.tr_solve_lower_triangular_mut(&mut s.solved);
+        let variance = map.kernel.prior_variance() - map.explained(&s.kstar, &mut s.solved, &mut s.spare, true);
         s.d_variance.gemv_tr(-2.0, &s.dk, &s.solved, 0.0);
         variance
     }
@@ -341,10 +341,24 @@ mod tests {
         )
     }
 
-    /// Both objectives' gradients against central differences at points on and off the data.
+    /// Both objectives' gradients against central differences at points on and off the data,
+    /// under the exact decoder and under a sparse one (8 of the 15 points as inducing inputs,
+    /// whose projection starts from the postures they decode to).
     #[test]
     fn gradients_match_central_differences() {
         let (p, postures) = projection();
+        check_gradients(&p, &postures);
+        let (exact, _) = toy();
+        let inducing = DMatrix::from_fn(2, 8, |i, j| exact.inputs[(i, 2 * j)]);
+        let sparse = GpMap::sparse(inducing.clone(), &exact.inputs, &postures, exact.kernel).unwrap();
+        let decoded = sparse.predict_mean(&inducing).unwrap();
+        check_gradients(
+            &Projection::new(&sparse, decoded, ProjectionConfig::default()).unwrap(),
+            &postures,
+        );
+    }
+
+    fn check_gradients(p: &Projection, postures: &DMatrix<f64>) {
         let mut s = p.scratch();
         let x: Vec<f64> = postures.column(6).iter().map(|v| v + 0.05).collect();
         for z in [[0.1, -0.2], [-1.3, 0.4], [2.0, 1.1], [0.0, 0.0]] {
