@@ -230,3 +230,18 @@ def test_a_trial_that_stopped_improving_stops_and_is_read_as_it_ran(arms_model: 
     assert sum(policy.end_counts(last=5).values()) == 2 * 5
     verdict = training_verdict(policy, episodes=2)
     assert sum(verdict.late_ends.values()) == sum(max(1, int(ran.min()) // 5) for _ in ran)
+
+
+def test_timeouts_are_told_apart_by_their_reward_per_step() -> None:
+    """Issue #37: timed-out episodes earning ≥ ½ per step hover near the target (a smaller step
+    may land); earning less they wander away from it, where a smaller step does not help (the
+    zoo's iiwa arm: its timeouts sat in a band of the latent space far from the demos)."""
+    from types import SimpleNamespace
+
+    from latentrl.verdict import timeout_advice
+
+    policy = SimpleNamespace(task=SimpleNamespace(to_dict=lambda: {"episode": {"max_steps": 200}}))
+    assert "near the target (mean reward 0.60 per step): a smaller learner.step" in timeout_advice(
+        policy, np.array([110.0, 130.0]))
+    far = timeout_advice(policy, np.array([10.0, 30.0]))
+    assert "away from the target (mean reward 0.10 per step)" in far and "smaller learner.step" not in far

@@ -34,6 +34,10 @@ LEARNT = 0.8
 RISING = 0.05
 """A reach rate that rose by more than this between the last two tenths of training is still rising."""
 
+NEAR = 0.5
+"""Mean reward per step (of at most 1) from which timed-out episodes count as hovering near the
+target: the reward exp(−θ ‖(h − h*)/ℓ‖²) is ½ at ‖h − h*‖ = ℓ √(ln 2 / θ), 1.4 ℓ at θ = 0.35."""
+
 ADVICE = {
     "obstacle": "learner.move_correction = true (moves that meet an obstacle on the way), or a smaller learner.step",
     "drop": "a smaller learner.step or stiffer servos (the check's servos finding): the constraint breaks on the way",
@@ -76,6 +80,18 @@ def success_share(summary: dict[str, Any]) -> float:
     return float(summary["reached_any_step"] if summary["success"] is None else summary["success"])
 
 
+def timeout_advice(policy: Any, returns: NDArray[np.float64]) -> str:
+    """What to try when most failing episodes time out, by their mean reward per step (`returns`
+    of those episodes over `episode.max_steps`): at least `NEAR` hovers near the target, less
+    wanders away from it."""
+    per_step = float(np.mean(returns)) / policy.task.to_dict()["episode"]["max_steps"]
+    if per_step >= NEAR:
+        return (f"failing episodes time out near the target (mean reward {per_step:.2f} per step): a smaller "
+                "learner.step, so a move can land inside target.reach_radius")
+    return (f"failing episodes time out away from the target (mean reward {per_step:.2f} per step): where they "
+            "wander (failures.png) the learnt value is flat; more --episodes, or starts through there")
+
+
 def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings: Any = None) -> Verdict:
     """The verdict of the module docs on `policy` (a LatentPolicy with its training record), from
     `episodes` rollouts per trial and policy; `findings`: a `check.CheckReport` whose advice joins."""
@@ -111,9 +127,9 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
             worst = names[int(np.bincount(failing, minlength=len(names)).argmax())]
             if worst in ADVICE:
                 steps.append(f"most failing episodes end as {worst}: {ADVICE[worst]}")
-            elif worst == "timeout" and reach_late > 0:
-                steps.append("failing episodes time out near the target: a smaller learner.step, so a move can land "
-                             "inside target.reach_radius")
+            elif worst == "timeout":
+                steps.append(timeout_advice(policy, last(np.asarray(policy.record["returns"]), fifth)[
+                    ~last(reached, fifth)][failing == names.index("timeout")]))
         if rising:
             steps.append("the reach rate was still rising at the end: more --episodes")
         if verdict == "never reached it":
