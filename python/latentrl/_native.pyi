@@ -65,9 +65,14 @@ class GpMap:
     """A fitted GP map (paper Eq. 4): predictive mean and variance from inputs to outputs."""
 
     def __new__(
-        cls, inputs: NDArray[np.float64], outputs: NDArray[np.float64], theta: NDArray[np.float64]
+        cls,
+        inputs: NDArray[np.float64],
+        outputs: NDArray[np.float64],
+        theta: NDArray[np.float64],
+        inducing: NDArray[np.float64] | None = None,
     ) -> GpMap:
-        """Fits the map to `inputs` (N, q) and `outputs` (N, p) with `theta` = (θ1, θ2, θ3)."""
+        """Fits the map to `inputs` (N, q) and `outputs` (N, p) with `theta` = (θ1, θ2, θ3); with
+        `inducing` (m, q), the sparse (DTC) map through those inducing inputs."""
     @staticmethod
     def back_constraint(inputs: NDArray[np.float64], weights: NDArray[np.float64], log_beta: float) -> GpMap:
         """The back-constrained GPLVM's encoder: mean `weights · k_b(inputs, x)` with `weights`
@@ -187,10 +192,14 @@ class Sim:
         """Every (link name, obstacle id) pair whose shapes are within the contact margin."""
 
 def gplvm_nll_grad(
-    latent: NDArray[np.float64], data: NDArray[np.float64], log_theta: NDArray[np.float64]
+    latent: NDArray[np.float64],
+    data: NDArray[np.float64],
+    log_theta: NDArray[np.float64],
+    inducing: NDArray[np.float64] | None = None,
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64], float]:
-    """GPLVM objective at `latent` (N, d) for centred `data` (N, D):
-    returns (nll, dnll/dlatent (N, d), dnll/dlog_theta (3,), jitter)."""
+    """GPLVM objective at `latent` (N, d) for centred `data` (N, D): returns (nll, dnll/dlatent
+    (N, d), dnll/dlog_theta (3,), jitter); with `inducing` (m, d) the sparse (DTC) bound, its
+    gradient (N + m, d) that of the latent points then of the inducing inputs."""
 def gplvm_back_constrained_nll_grad(
     weights: NDArray[np.float64], data: NDArray[np.float64], log_theta: NDArray[np.float64], log_beta: float
 ) -> tuple[float, NDArray[np.float64], NDArray[np.float64], float, NDArray[np.float64], float]:

@@ -15,6 +15,7 @@ use nalgebra::{Cholesky, DMatrix, Dyn};
 
 use crate::error::{CoreError, Result, check_finite};
 use crate::gp::{GpMap, check_gp_size, check_points, check_values};
+use crate::gplvm::NllGrad;
 use crate::kernel::{SeKernel, factorize};
 
 /// `L(Z, U, θ)` and its gradient with respect to `Z`, `U` and `log θ`.
@@ -30,6 +31,22 @@ pub struct SparseNllGrad {
     pub grad_log_theta: [f64; 3],
     /// Jitter added to `K_mm` to factorise it (0 if none).
     pub jitter: f64,
+}
+
+impl SparseNllGrad {
+    /// As an [`NllGrad`] whose gradient of the points is `[∂L/∂Z  ∂L/∂U]` (q×(N+m)): the
+    /// points an optimiser moves together, latent points first.
+    pub fn stacked(self) -> NllGrad {
+        let (n, m) = (self.grad_latent.ncols(), self.grad_inducing.ncols());
+        let mut grad_latent = self.grad_latent.resize_horizontally(n + m, 0.0);
+        grad_latent.columns_mut(n, m).copy_from(&self.grad_inducing);
+        NllGrad {
+            nll: self.nll,
+            grad_latent,
+            grad_log_theta: self.grad_log_theta,
+            jitter: self.jitter,
+        }
+    }
 }
 
 /// The factors of the DTC model that the bound, its gradient and the sparse map share.

@@ -1,7 +1,7 @@
 //! Binding of `latent_core::gp` and `latent_core::gplvm`.
 
 use latent_core::back_constraint::{encoder, nll_grad_back_constrained};
-use latent_core::{GpMap, SeKernel, nll_grad};
+use latent_core::{GpMap, SeKernel, SparseNllGrad, nll_grad, sparse_nll_grad};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
@@ -33,19 +33,28 @@ pub struct PyGpMap {
 
 #[pymethods]
 impl PyGpMap {
-    /// Fits the map to `inputs` (N, q) and `outputs` (N, p) with `theta` = (θ1, θ2, θ3).
+    /// Fits the map to `inputs` (N, q) and `outputs` (N, p) with `theta` = (θ1, θ2, θ3); with
+    /// `inducing` (m, q), the sparse (DTC) map through those inducing inputs.
     #[new]
+    #[pyo3(signature = (inputs, outputs, theta, inducing = None))]
     fn new(
         py: Python<'_>,
         inputs: PyReadonlyArray2<'_, f64>,
         outputs: PyReadonlyArray2<'_, f64>,
         theta: PyReadonlyArray1<'_, f64>,
+        inducing: Option<PyReadonlyArray2<'_, f64>>,
     ) -> PyResult<Self> {
         guard(|| {
             let inputs = points("inputs", &inputs)?;
             let outputs = points("outputs", &outputs)?;
             let kernel = SeKernel::new(fixed::<3>("theta", &theta)?).map_err(to_py)?;
-            let inner = py.detach(|| GpMap::new(inputs, outputs, kernel)).map_err(to_py)?;
+            let inducing = inducing.map(|u| points("inducing", &u)).transpose()?;
+            let inner = py
+                .detach(|| match inducing {
+                    Some(u) => GpMap::sparse(u, &inputs, &outputs, kernel),
+                    None => GpMap::new(inputs, outputs, kernel),
+                })
+                .map_err(to_py)?;
             Ok(Self { inner })
         })
     }
@@ -137,20 +146,29 @@ impl PyGpMap {
     }
 }
 
-/// GPLVM objective at `latent` (N, d) for centred `data` (N, D):
-/// returns (nll, dnll/dlatent (N, d), dnll/dlog_theta (3,), jitter).
+/// GPLVM objective at `latent` (N, d) for centred `data` (N, D): returns (nll, dnll/dlatent
+/// (N, d), dnll/dlog_theta (3,), jitter); with `inducing` (m, d) the sparse (DTC) bound, its
+/// gradient (N + m, d) that of the latent points then of the inducing inputs.
 #[pyfunction]
+#[pyo3(signature = (latent, data, log_theta, inducing = None))]
 pub fn gplvm_nll_grad<'py>(
     py: Python<'py>,
     latent: PyReadonlyArray2<'py, f64>,
     data: PyReadonlyArray2<'py, f64>,
     log_theta: PyReadonlyArray1<'py, f64>,
+    inducing: Option<PyReadonlyArray2<'py, f64>>,
 ) -> PyResult<NllGradient<'py>> {
     guard(|| {
         let latent = points("latent", &latent)?;
         let data = points("data", &data)?;
         let log_theta = fixed::<3>("log_theta", &log_theta)?;
-        let r = py.detach(|| nll_grad(&latent, &data, log_theta)).map_err(to_py)?;
+        let inducing = inducing.map(|u| points("inducing", &u)).transpose()?;
+        let r = py
+            .detach(|| match inducing {
+                None => nll_grad(&latent, &data, log_theta),
+                Some(u) => sparse_nll_grad(&latent, &u, &data, log_theta).map(SparseNllGrad::stacked),
+            })
+            .map_err(to_py)?;
         Ok((
             r.nll,
             to_points(py, r.grad_latent)?,
