@@ -245,3 +245,11 @@ def test_timeouts_are_told_apart_by_their_reward_per_step() -> None:
         policy, np.array([110.0, 130.0]))
     far = timeout_advice(policy, np.array([10.0, 30.0]))
     assert "away from the target (mean reward 0.10 per step)" in far and "smaller learner.step" not in far
+
+
+def test_obstacle_advice_does_not_repeat_what_the_run_already_did() -> None:
+    from latentrl.verdict import end_advice
+
+    assert "move_correction = true" in str(end_advice("obstacle", {"move_correction": False}))
+    assert "move_correction" not in str(end_advice("obstacle", {"move_correction": True}))
+    assert end_advice("timeout", {"move_correction": False}) is None

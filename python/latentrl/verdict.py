@@ -80,6 +80,14 @@ def success_share(summary: dict[str, Any]) -> float:
     return float(summary["reached_any_step"] if summary["success"] is None else summary["success"])
 
 
+def end_advice(worst: str, learner: dict[str, Any]) -> str | None:
+    """`ADVICE` for the ending most failing episodes had, under the `learner` settings they ran
+    with (move corrections already on: only the step is left to try)."""
+    if worst == "obstacle" and learner["move_correction"]:
+        return "a smaller learner.step (move corrections are on)"
+    return ADVICE.get(worst)
+
+
 def timeout_advice(policy: Any, returns: NDArray[np.float64]) -> str:
     """What to try when most failing episodes time out, by their mean reward per step (`returns`
     of those episodes over `episode.max_steps`): at least `NEAR` hovers near the target, less
@@ -125,8 +133,9 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
         failing = late[~last(reached, fifth)]
         if failing.size:
             worst = names[int(np.bincount(failing, minlength=len(names)).argmax())]
-            if worst in ADVICE:
-                steps.append(f"most failing episodes end as {worst}: {ADVICE[worst]}")
+            advice = end_advice(worst, policy.task.to_dict()["learner"])
+            if advice is not None:
+                steps.append(f"most failing episodes end as {worst}: {advice}")
             elif worst == "timeout":
                 steps.append(timeout_advice(policy, last(np.asarray(policy.record["returns"]), fifth)[
                     ~last(reached, fifth)][failing == names.index("timeout")]))
