@@ -91,6 +91,20 @@ def test_unknown_flag_exits_2():
     assert exit_info.value.code == 2
 
 
+@pytest.mark.parametrize("argv", [["--help"], ["train", "--nope"]])
+def test_help_and_a_bad_flag_load_no_experiment(argv):
+    """Issue #39, item 5: a subcommand's flags are built when it is used, so `--help` and a
+    mistyped flag import no experiment, its registry or tqdm (benches/bench_startup.py times them)."""
+    code = ("import contextlib, io, sys; from latentrl.cli import main\n"
+            "with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):\n"
+            "    try: main(sys.argv[1:])\n"
+            "    except SystemExit: pass\n"
+            "print(sorted(m for m in sys.modules if m.startswith(('latentrl.experiments.exp', "
+            "'latentrl.experiments.table1', 'latentrl.experiments.registry', 'tqdm'))))")
+    done = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=300, check=True)
+    assert done.stdout.strip() == "[]"
+
+
 @pytest.mark.parametrize(
     "script", ["table1.py", "exp1.py", pytest.param("exp2.py", marks=pytest.mark.slow)]
 )

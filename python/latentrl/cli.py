@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import functools
 import json
 import os
 import sys
@@ -20,10 +21,7 @@ from typing import Any
 
 from latentrl import _native
 from latentrl.experiments.presets import field_docs, with_overrides
-from latentrl.experiments.registry import experiments, task_schema
-from latentrl.experiments.results import environment, read_json, write_json
-from latentrl.recorded.options import DemoOptions
-from latentrl.render import CAMERA, VIEWS
+from latentrl.lazy_parser import LazyParser
 from latentrl.run_lock import run_lock
 from latentrl.task import by_path, changed_since
 from latentrl.train import POLICIES, format_rollout
@@ -40,6 +38,9 @@ def saved_run(out_dir: Path, *, train: bool = False) -> tuple[str, Any]:
     """(experiment name, preset) of the RL run in `out_dir`, from its results.json — with `train`,
     also ("train", its TrainRun) for a `latentrl train` directory; ValueError if the directory
     holds none, or the preset does not fit this version."""
+    from latentrl.experiments.registry import experiments
+    from latentrl.experiments.results import read_json
+
     meta_path = out_dir / "results.json"
     if not meta_path.is_file():
         raise ValueError(f"{out_dir}: no results.json there, so no run of an RL experiment")
@@ -69,6 +70,8 @@ def _as_recorded(out_dir: Path, name: str, preset: Any, recorded: dict[str, Any]
     version's task does not give (a shipped task file changed since the run): its figures, replays and resume
     use the task its trials ran with. A key added since the run takes its default, the
     behaviour before it. A key no override can set is a ValueError."""
+    from latentrl.experiments.registry import experiments, task_schema
+
     rl = experiments()[name].rl
     assert rl is not None
     changed = {k: v for k, v in changed_since(recorded, rl.task(preset)).items() if k not in preset.task}
@@ -152,37 +155,77 @@ def _add_task_flags(
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every subcommand and flag."""
+    """The argument parser with every subcommand and flag; a subcommand's flags are added when it
+    is used (`LazyParser`), so `latentrl --help` imports no experiment or its preset."""
     parser = argparse.ArgumentParser(prog="latentrl", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
-    run = sub.add_parser("run", help="run an experiment and write its results directory")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=LazyParser)
+    sub.add_parser("run", help="run an experiment and write its results directory", fill=_run_flags)
+    sub.add_parser("train", help="train a latent policy on a task file from demonstrations; writes DIR/policy.npz",
+                   fill=_train_flags)
+    sub.add_parser("check", help="before training: will the task learn from these demos? (exit 3 if not)",
+                   fill=_check_flags)
+    sub.add_parser("report", help="the verdict on a trained policy: learnt, stopped improving below the "
+                                  "target, or never reached it, with what to try next", fill=_report_flags)
+    sub.add_parser("rollout", help="run a trained policy frozen (greedy, soft-max, and the random control from "
+                                   "the same starts) and write OUT/rollout.json", fill=_rollout_flags)
+    sub.add_parser("fit", help="fit a PCA or GPLVM to a demonstration file and save it (NPZ)", fill=_fit_flags)
+    sub.add_parser("plot", help="redraw the figures of a results directory (finished trials only)", fill=_plot_flags)
+    sub.add_parser("sweep", help="run an RL experiment over a grid of preset values, here or on a Ray cluster",
+                   fill=_sweep_flags)
+    sub.add_parser("info", help="print versions, git revision and thread count as JSON")
+    sub.add_parser("replay", help="render a recorded episode of an Exp 1, Exp 2, Exp 3 or latentrl train run to a GIF or MP4 (the [video] extra) or a Rerun recording (the [viewer] extra)",
+                   fill=_replay_flags)
+    sub.add_parser("urdf-info", help="what a URDF holds as the physics loads it: joints, links, collision shapes, mass",
+                   fill=_urdf_info_flags)
+    return parser
+
+
+def _run_flags(run: argparse.ArgumentParser) -> None:
+    """`run`'s subcommands, one per experiment (each adding its flags when used)."""
+    from latentrl.experiments.registry import experiments
+
     run_sub = run.add_subparsers(dest="experiment", required=True)
     for name, exp in experiments().items():
-        cmd = run_sub.add_parser(name, help=(exp.preset.__doc__ or "").strip().splitlines()[0])
-        cmd.add_argument("--out", type=Path, help=f"results directory (default: results/{name})")
-        cmd.add_argument("--quick", action="store_true", help="the small smoke-test preset")
-        if exp.rl:
-            cmd.add_argument(
-                "--resume", type=Path, metavar="DIR",
-                help="continue the interrupted run in DIR with its own preset (no other preset flags)",
-            )
-        cmd.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
-        _add_preset_flags(cmd, exp.preset)
-        if exp.rl:
-            _add_task_flags(cmd, task_schema(name), exp.rl.task(exp.preset()))
-    train = sub.add_parser("train", help="train a latent policy on a task file from demonstrations; writes DIR/policy.npz")
+        run_sub.add_parser(name, help=(exp.preset.__doc__ or "").strip().splitlines()[0],
+                           fill=functools.partial(_experiment_flags, name))
+
+
+def _experiment_flags(name: str, cmd: argparse.ArgumentParser) -> None:
+    """`run NAME`'s flags: its preset's fields and, for an RL experiment, its task's keys (the
+    defaults shown: its task file's)."""
+    from latentrl.experiments.registry import experiments, task_schema
+
+    exp = experiments()[name]
+    cmd.add_argument("--out", type=Path, help=f"results directory (default: results/{name})")
+    cmd.add_argument("--quick", action="store_true", help="the small smoke-test preset")
+    if exp.rl:
+        cmd.add_argument(
+            "--resume", type=Path, metavar="DIR",
+            help="continue the interrupted run in DIR with its own preset (no other preset flags)",
+        )
+    cmd.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
+    _add_preset_flags(cmd, exp.preset)
+    if exp.rl:
+        _add_task_flags(cmd, task_schema(name), exp.rl.task(exp.preset()))
+
+
+def _train_flags(train: argparse.ArgumentParser) -> None:
     train.add_argument("--out", type=Path, required=True, help="results directory (results.json, returns.npz, policy.npz)")
     train.add_argument("--resume", action="store_true", help="continue the interrupted run in --out (same arguments)")
     _add_training_flags(train, "a short run (TrainPreset.quick)")
-    check = sub.add_parser("check", help="before training: will the task learn from these demos? (exit 3 if not)")
+
+
+def _check_flags(check: argparse.ArgumentParser) -> None:
     check.add_argument("--json", action="store_true", help="print the findings as JSON instead of a table")
     _add_training_flags(check, "cost the short run (TrainPreset.quick) instead of the default")
-    report = sub.add_parser("report", help="the verdict on a trained policy: learnt, stopped improving below the "
-                                           "target, or never reached it, with what to try next")
+
+
+def _report_flags(report: argparse.ArgumentParser) -> None:
     report.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz)")
     report.add_argument("--json", action="store_true", help="print it as JSON")
-    rollout = sub.add_parser("rollout", help="run a trained policy frozen (greedy, soft-max, and the random control from "
-                                             "the same starts) and write OUT/rollout.json")
+
+
+def _rollout_flags(rollout: argparse.ArgumentParser) -> None:
     rollout.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz), or a policy.npz")
     rollout.add_argument("--out", type=Path, required=True, help="where to write rollout.json and rollout.npz")
     rollout.add_argument("--episodes", type=int, default=20, help="episodes per trial and policy (default: 20)")
@@ -195,7 +238,11 @@ def build_parser() -> argparse.ArgumentParser:
                          help="which of greedy, softmax (the learner's soft-max, as the frozen tests draw) and random "
                               "(the control: uniform moves, cannot learn) to run (default: all three)")
     rollout.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
-    fit = sub.add_parser("fit", help="fit a PCA or GPLVM to a demonstration file and save it (NPZ)")
+
+
+def _fit_flags(fit: argparse.ArgumentParser) -> None:
+    from latentrl.recorded.options import DemoOptions
+
     fit.add_argument("demos", type=Path, help=DEMOS_HELP)
     fit.add_argument("--model", choices=("gplvm", "pca"), default="gplvm", help="the model (default: gplvm)")
     fit.add_argument("--n-components", type=_dimension, default=2,
@@ -204,10 +251,14 @@ def build_parser() -> argparse.ArgumentParser:
     fit.add_argument("--max-iter", type=int, default=1000, help="L-BFGS iteration cap of the GPLVM (default: 1000)")
     fit.add_argument("--out", type=Path, required=True, help="the model file to write (.npz; load with GPLVM.load)")
     _add_preset_flags(fit, DemoOptions)
-    plot = sub.add_parser("plot", help="redraw the figures of a results directory (finished trials only)")
+
+
+def _plot_flags(plot: argparse.ArgumentParser) -> None:
     plot.add_argument("results", type=Path, help="a results directory of `latentrl run exp1|exp2|exp3`")
     plot.add_argument("--out", type=Path, help="where to write the figures (default: the results directory)")
-    sweep = sub.add_parser("sweep", help="run an RL experiment over a grid of preset values, here or on a Ray cluster")
+
+
+def _sweep_flags(sweep: argparse.ArgumentParser) -> None:
     sweep.add_argument("file", type=Path, help="the sweep: a .toml file (or .yaml with PyYAML); see examples/sweep.toml")
     sweep.add_argument("--backend", choices=("local", "ray"), default="local",
                        help="local: trials in this process (rayon); ray: one Ray task per trial (default: local)")
@@ -218,8 +269,11 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--out", type=Path, help="sweep directory (default: results/<FILE's name>)")
     sweep.add_argument("--resume", action="store_true", help="continue the sweep in --out; finished trials are kept")
     sweep.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
-    sub.add_parser("info", help="print versions, git revision and thread count as JSON")
-    replay = sub.add_parser("replay", help="render a recorded episode of an Exp 1, Exp 2, Exp 3 or latentrl train run to a GIF or MP4 (the [video] extra) or a Rerun recording (the [viewer] extra)")
+
+
+def _replay_flags(replay: argparse.ArgumentParser) -> None:
+    from latentrl.render import CAMERA, VIEWS
+
     replay.add_argument("results", type=Path, help="a results directory of latentrl run exp1|exp2|exp3, latentrl train "
                                                      "or latentrl rollout")
     replay.add_argument("--out", type=Path, help="the video: FILE.gif or FILE.mp4")
@@ -237,12 +291,13 @@ def build_parser() -> argparse.ArgumentParser:
                         help="the robot seen from the top (x-y), the side (x-z), the front (y-z) or in 3d (perspective, "
                              f"elevation {CAMERA[0]:g}°, azimuth {CAMERA[1]:g}°); default: the side of a floating robot, "
                              "else the plane its links and target spread over most")
-    urdf = sub.add_parser("urdf-info", help="what a URDF holds as the physics loads it: joints, links, collision shapes, mass")
+
+
+def _urdf_info_flags(urdf: argparse.ArgumentParser) -> None:
     urdf.add_argument("urdf", type=Path, help="the robot's URDF file")
     urdf.add_argument("--json", action="store_true", help="print it as JSON instead of a table")
     urdf.add_argument("--balance-inertia", action="store_true",
                       help="repair inertias the physics refuses (triangle inequality, all zero), naming each link")
-    return parser
 
 
 def _add_training_flags(cmd: argparse.ArgumentParser, quick: str) -> None:
@@ -283,6 +338,8 @@ def _flag(key: str) -> str:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from latentrl.experiments.registry import experiments
+
     exp = experiments()[args.experiment]
     overrides = _overrides(args, exp.preset)
     resume = getattr(args, "resume", None)
@@ -350,6 +407,7 @@ def _report_of(out: Path, *, write: bool = False, as_json: bool = False) -> None
     """The verdict on the policy in `out` (rollouts from the test starts, the check's advice);
     printed, and with `write` saved as `out/report.json`."""
     from latentrl.check import check_task
+    from latentrl.experiments.results import environment, write_json
     from latentrl.train import LatentPolicy
     from latentrl.verdict import training_verdict
 
@@ -418,7 +476,7 @@ def _rollout(args: argparse.Namespace) -> int:
 
 
 def _write_rollout(args: argparse.Namespace, path: Path, policy: Any, results: dict[str, dict[str, Any]]) -> None:
-    from latentrl.experiments.results import write_npz
+    from latentrl.experiments.results import environment, write_json, write_npz
 
     write_npz(args.out / "rollout.npz", {f"{kind}_{k}": r[k] for kind, r in results.items()
                                          for k in ("returns", "ends", "reached", "paths")})
@@ -440,6 +498,7 @@ def _policies(text: str) -> list[str]:
 
 def _fit(args: argparse.Namespace) -> int:
     from latentrl import GPLVM, PCA, load_demos
+    from latentrl.recorded.options import DemoOptions
 
     if args.out.suffix != ".npz":
         raise ValueError(f"--out {args.out}: a model is saved as NPZ; give a file name ending in .npz")
@@ -466,6 +525,7 @@ def _fit(args: argparse.Namespace) -> int:
 
 
 def _plot(args: argparse.Namespace) -> int:
+    from latentrl.experiments.registry import experiments
     from latentrl.experiments.runner import finished_trials, load_arrays
 
     name, preset = saved_run(args.results)
@@ -553,6 +613,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
     args = build_parser().parse_args(argv)
     if args.command == "info":
+        from latentrl.experiments.results import environment
+
         print(json.dumps(environment(), indent=2))
         return 0
     command = {"run": _run, "train": _train, "check": _check, "report": _report, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep,

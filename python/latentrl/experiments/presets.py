@@ -11,8 +11,11 @@ checked by the native side's rules.
 from __future__ import annotations
 
 import ast
+import contextlib
 import dataclasses
 import inspect
+import re
+import sys
 import textwrap
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -43,8 +46,7 @@ def field_docs(preset_cls: type) -> dict[str, str]:
     for cls in reversed(preset_cls.__mro__):
         if not dataclasses.is_dataclass(cls):
             continue
-        tree = ast.parse(textwrap.dedent(inspect.getsource(cls)))
-        body = tree.body[0].body  # type: ignore[attr-defined]
+        body = _class_body(cls)
         for item, doc in zip(body, body[1:]):
             if (
                 isinstance(item, ast.AnnAssign)
@@ -55,6 +57,23 @@ def field_docs(preset_cls: type) -> dict[str, str]:
             ):
                 docs[item.target.id] = " ".join(doc.value.value.split())
     return docs
+
+
+def _class_body(cls: type) -> list[ast.stmt]:
+    """The statements of `cls`'s definition. A class at the top of its module is parsed alone: its
+    lines from `class Name` to the next line at column 0 (`inspect.getsource` parses the whole
+    module, ten times slower; `train --help` reads four). Where that cut is not the whole class
+    (it fell in a string or brackets: a SyntaxError), or the class is nested: `inspect.getsource`."""
+    source = inspect.getsource(sys.modules[cls.__module__])
+    block = re.search(rf"^class {cls.__name__}\b.*?(?=^[^\s#]|\Z)", source, re.M | re.S)
+    tree = None
+    if block and cls.__qualname__ == cls.__name__:
+        with contextlib.suppress(SyntaxError):
+            tree = ast.parse(block.group(0))
+    tree = tree or ast.parse(textwrap.dedent(inspect.getsource(cls)))
+    definition = tree.body[0]
+    assert isinstance(definition, ast.ClassDef)
+    return definition.body
 
 
 def describe(preset: Any) -> dict[str, Any]:

@@ -10,7 +10,6 @@ import platform
 import resource
 import subprocess
 from collections.abc import Mapping
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -79,6 +78,8 @@ def environment() -> dict[str, Any]:
     threads. The CPU matters for reproducing numbers: the same seed gives the same results on
     one machine, but the physics' f32 maths (glibc picks CPU-specific sin/cos/exp) may differ
     in the last bits on another CPU, and RL runs amplify that."""
+    from importlib import metadata  # (and its email parsers): loaded by a run, not by `--help`
+
     versions: dict[str, str | None] = {}
     for name in ("latentrl", "numpy", "scipy", "matplotlib"):
         try:

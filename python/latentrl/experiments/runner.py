@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
-from latentrl.progress import progress_bar
 
 from latentrl._base import read_npz
 from latentrl.run_lock import run_lock
@@ -156,6 +155,8 @@ def run_rl(
 def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
             figures: Callable[[Any, Mapping[str, np.ndarray], Path, Path], None], progress: bool,
             chunk: int | None, execute: Execute) -> dict[str, Any]:
+    from latentrl.progress import progress_bar  # tqdm: loaded by a run, not by `run NAME --help`
+
     meta_path, arrays_path = out / "results.json", out / "returns.npz"
     plan = describe(preset)
     arrays, meta = _previous(meta_path, arrays_path, plan)

@@ -9,7 +9,7 @@ import json
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -17,14 +17,14 @@ from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded
 from latentrl.demos import load_demos
 from latentrl.recorded import recording_kind
 from latentrl.recorded.options import DemoOptions
-from latentrl.derive import Derived, applied, derive
-from latentrl.experiments.latent_runs import Fitted, latent_setup, run_fit
 from latentrl.experiments.presets import latent_box
-from latentrl.experiments.results import read_json
-from latentrl.experiments.runner import Setup, check_inputs, finished_trials, load_arrays
 from latentrl.gplvm import GPLVM
 from latentrl.task import Task
 from latentrl.train import LatentPolicy, TrainPreset
+
+if TYPE_CHECKING:  # the fit, the runner and the derivations load with the first run, not with `train --help`
+    from latentrl.derive import Derived
+    from latentrl.experiments.runner import Setup
 
 
 @dataclass(frozen=True)
@@ -76,6 +76,11 @@ def fitted(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GP
 def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GPLVM, tuple[Derived, ...]]:
     """`fitted`, and the settings `latentrl.derive` derived for it (cached per task, fit and
     margin)."""
+    from latentrl.derive import applied, derive
+    from latentrl.experiments.latent_runs import Fitted, run_fit
+    from latentrl.experiments.results import read_json
+    from latentrl.experiments.runner import check_inputs
+
     overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
     options = DemoOptions(**{f.name: getattr(run, f.name) for f in dataclasses.fields(DemoOptions)})
     task, demos, model = _load(run.task_file, overrides, run.demos, options, run.model, run.seed, run.gplvm_max_iter,
@@ -102,6 +107,8 @@ _DERIVED: dict[tuple[Any, ...], tuple[Derived, ...]] = {}
 def setup(run: TrainRun, out: Path | None = None) -> Setup:
     """The task's learner on the GPLVM's latent box (the run's in directory `out`); results.json
     records the derived settings (`setup.derived`)."""
+    from latentrl.experiments.latent_runs import latent_setup
+
     task, demos, model, settings = prepared(run, out)
     built = latent_setup(run, task, model, latent_box(model.Z_, run.latent_margin), demos)
     built.info["derived"] = [d.to_dict() for d in settings]
@@ -127,6 +134,8 @@ def input_digests(task_file: str, task: Task, demos: np.ndarray, model: GPLVM) -
 
 def save_policy(run: TrainRun, out: Path) -> LatentPolicy:
     """`out/policy.npz` from the finished trials of the run in `out`."""
+    from latentrl.experiments.runner import finished_trials, load_arrays
+
     task, demos, model = fitted(run, out)
     arrays, done = finished_trials(load_arrays(out))
     if not done:
