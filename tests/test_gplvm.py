@@ -237,6 +237,7 @@ def test_params_and_repr():
         "tol",
         "max_components",
         "relevance_threshold",
+        "inducing",
     }
 
 

@@ -430,16 +430,22 @@ def check_format(arrays: Mapping[str, Any], expected: str, path: str) -> None:
                          f"{FORMAT_VERSION})")
 
 
+#: The most inputs whose pairwise distances `initial_log_theta` takes the median of.
+MEDIAN_SAMPLE = 4096
+
+
 def initial_log_theta(
     inputs: NDArray[np.float64], centred: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """Starting log θ for a GP from `inputs` (N, q) to `centred` outputs (N, p): θ1 the mean
-    output variance, θ2 the median squared distance between inputs, θ3 = θ1 / 100
+    output variance, θ2 the median squared distance between inputs (between `MEDIAN_SAMPLE`
+    evenly spaced ones when N is larger: pdist of N points takes N²/2 floats), θ3 = θ1 / 100
     (1 where a scale is zero)."""
     from scipy.spatial.distance import pdist  # SciPy loads at a fit, not at `import latentrl`
 
     variance = float(np.mean(centred**2)) or 1.0
-    lengthscale_sq = float(np.median(pdist(inputs, "sqeuclidean"))) or 1.0
+    sample = inputs[np.linspace(0, len(inputs) - 1, MEDIAN_SAMPLE).astype(np.intp)] if len(inputs) > MEDIAN_SAMPLE else inputs
+    lengthscale_sq = float(np.median(pdist(sample, "sqeuclidean"))) or 1.0
     # Clamped at the smallest normal float: data of scale 1e-161 underflows θ3 to 0.
     return np.log(np.maximum([variance, lengthscale_sq, variance / 100], np.finfo(np.float64).tiny))
 
@@ -455,6 +461,7 @@ class NllFit:
     converged: bool
     message: str
     jitter: float
+    inducing: NDArray[np.float64] | None = None
 
 
 def lbfgs(objective: Callable[[NDArray[np.float64]], tuple[float, NDArray[np.float64]]], x0: NDArray[np.float64],
@@ -478,42 +485,54 @@ def minimise_nll(
     noise_floor: float,
     max_iter: int,
     tol: float,
+    inducing: NDArray[np.float64] | None = None,
 ) -> NllFit:
     """Minimises the GP negative log marginal likelihood (paper Eq. 1, 3) of centred `data`
     (N, D) given inputs `latent` (N, d) with L-BFGS-B and the analytic gradient: over
     `log θ`, and over the inputs too if `fit_latent` (the GPLVM). θ3 is bounded below by
     `noise_floor`; `latent_prior` adds ½‖Z‖². Stops when the relative decrease of the
     objective or the largest projected gradient falls below `tol`, or after `max_iter`
-    iterations (then `converged` is False)."""
+    iterations (then `converged` is False). With `inducing` (m, d) the objective is the sparse
+    (DTC) bound through those inducing inputs (docs/method.md §Sparse GPLVM), optimised with the
+    inputs if `fit_latent` (else held fixed)."""
     n, d = latent.shape
+    # The points L-BFGS moves: the latent points, then the inducing inputs (the native
+    # gradient's row order); the data term alone with fixed inputs.
+    moved = np.vstack([latent, inducing]) if inducing is not None else latent
 
     def split(params: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        return (params[:-3].reshape(n, d) if fit_latent else latent), params[-3:]
+        return (params[:-3].reshape(moved.shape) if fit_latent else moved), params[-3:]
+
+    def evaluate(params: NDArray[np.float64]) -> tuple[float, NDArray[np.float64], NDArray[np.float64], float]:
+        points, lt = split(params)
+        if inducing is None:
+            return gplvm_nll_grad(points, data, lt)
+        return gplvm_nll_grad(points[:n], data, lt, inducing=points[n:])
 
     def objective(params: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
-        z, lt = split(params)
-        nll, grad_z, grad_lt, _ = gplvm_nll_grad(z, data, lt)
-        grad = np.concatenate([grad_z.ravel(), grad_lt]) if fit_latent else grad_lt
+        nll, grad_points, grad_lt, _ = evaluate(params)
+        grad = np.concatenate([grad_points.ravel(), grad_lt]) if fit_latent else grad_lt
         if latent_prior:
+            z = split(params)[0][:n]
             nll += 0.5 * float(np.sum(z * z))
             if fit_latent:
-                grad[:-3] += z.ravel()
+                grad[: n * d] += z.ravel()
         return nll, grad
 
     floor = np.log(noise_floor)
     x0 = np.concatenate(
-        [latent.ravel() if fit_latent else [], log_theta[:2], [max(log_theta[2], floor)]]
+        [moved.ravel() if fit_latent else [], log_theta[:2], [max(log_theta[2], floor)]]
     )
     bounds = [(None, None)] * (x0.size - 1) + [(floor, None)]
     res = lbfgs(objective, x0, bounds, max_iter=max_iter, tol=tol)
-    z, lt = split(res.x)
-    jitter = gplvm_nll_grad(z, data, lt)[3]
+    points, lt = split(res.x)
     return NllFit(
-        np.array(z),
+        np.array(points[:n]),
         np.array(lt),
         float(res.fun),
         int(res.nit),
         res.status == 0,
         str(res.message),
-        jitter,
+        evaluate(res.x)[3],
+        None if inducing is None else np.array(points[n:]),
     )

@@ -71,6 +71,16 @@ class GPLVM(Estimator):
     tol : float, default=1e-6
         L-BFGS-B stops when the relative decrease of the objective (ftol) or the largest
         projected gradient component (gtol) falls below `tol` (scipy's `tol`).
+    inducing : int or None, default=None
+        None: the exact GPLVM (O(N³) per step, at most `_native.MAX_GP_POINTS` postures). An int
+        m (1 ≤ m ≤ N): the sparse GPLVM, the DTC bound through m inducing inputs (docs/method.md
+        §Sparse GPLVM; O(N m² + m³) per step, O(N m) memory, no limit on N). The inducing inputs
+        start at the latent points of m postures chosen by farthest-point sampling of the start
+        latent points (`latentrl.recorded.sampling.farthest_points`: the first, then each time the
+        one farthest from those chosen; fewer if fewer are distinct) and are optimised with Z and
+        θ. Decoding is the DTC predictive mean and variance (O(m) and O(m²) per point); the GP
+        encoder is a DTC GP through the postures of those m rows; the projection starts from the
+        inducing input whose decoded posture is nearest. Not with encoder="back_constrained".
 
     Attributes
     ----------
@@ -111,8 +121,14 @@ class GPLVM(Estimator):
         Z → posture (Eq. 4).
     encoder_ : GpMap
         Posture → Z: the out-of-sample GP encoder, or the back-constraint.
-    projection_ : Projection
-        Posture → Z by iterative projection (SciPy L-BFGS-B; what `transform` uses).
+    inducing_ : ndarray (m, d)
+        The inducing inputs of a sparse fit ((0, d) for an exact one).
+    inducing_index_ : ndarray (m,) of int
+        The rows of `X_train_` whose latent points the inducing inputs started at; their
+        postures are the GP encoder's inducing inputs.
+    projection_ : Projection or latentrl._native.Projection
+        Posture → Z by iterative projection (SciPy L-BFGS-B; what `transform` uses); the native
+        one for a sparse fit (the SciPy reference is exact, O(N³)).
     native_projection_ : latentrl._native.Projection
         The same iterative projection in Rust, the one the RL loop runs (docs/encoders.md:
         how closely the two agree).
@@ -152,6 +168,8 @@ class GPLVM(Estimator):
         "encoder_theta_": ("f", (3,)),
         "encoder_weights_": ("f", ("N", "d")),
         "relevance_": ("f", ("K",)),
+        "inducing_": ("f", ("M", "d")),
+        "inducing_index_": ("i", ("M",)),
         "nll_": ("f", ()),
         "n_iter_": ("i", ()),
         "converged_": ("b", ()),
@@ -171,6 +189,7 @@ class GPLVM(Estimator):
         tol: float = 1e-6,
         max_components: int | None = None,
         relevance_threshold: float = 0.1,
+        inducing: int | None = None,
     ) -> None:
         self.n_components = n_components
         self.max_components = max_components
@@ -182,6 +201,7 @@ class GPLVM(Estimator):
         self.random_state = random_state
         self.encoder = encoder
         self.tol = tol
+        self.inducing = inducing
 
     def fit(self, X: Any, y: Any = None) -> Self:
         """Fits the latent points and kernel to postures `X` (N, D), an array or DataFrame;
@@ -193,9 +213,12 @@ class GPLVM(Estimator):
                 raise ValueError(f"n_components must be an int >= 1 or 'auto', got {self.n_components!r}")
             return self._fit_auto(X, names)
         check_n_components(self.n_components, X)
-        if len(X) > _native.MAX_GP_POINTS:
-            raise ValueError(f"X: {len(X)} postures, more than the {_native.MAX_GP_POINTS} a GPLVM fit takes "
-                             f"(its N × N kernel matrix would need {len(X) ** 2 * 8 / 2**30:.1f} GiB); subsample them")
+        inducing = self._check_inducing(len(X))
+        if inducing is None and len(X) > _native.MAX_GP_POINTS:
+            raise ValueError(f"X: {len(X)} postures, more than the {_native.MAX_GP_POINTS} an exact GPLVM fit takes "
+                             f"(its N × N kernel matrix would need {len(X) ** 2 * 8 / 2**30:.1f} GiB); fit the sparse "
+                             "GPLVM with inducing=M (e.g. GPLVM(inducing=256), `latentrl fit --inducing 256`), or keep "
+                             "fewer postures (load_demos(..., max_postures=N), --max-postures N)")
         if not np.ptp(X, axis=0).any():
             raise ValueError(f"X: all {len(X)} postures are identical; a GPLVM needs postures that differ")
         max_iter = int_at_least("max_iter", self.max_iter, 1)
@@ -217,14 +240,21 @@ class GPLVM(Estimator):
         from latentrl.inverse import fit_gp_encoder
 
         back_constrained = self.encoder == "back_constrained"
+        if back_constrained and inducing is not None:
+            raise ValueError("inducing: the back-constrained GPLVM is fitted exactly; use inducing=None "
+                             "or another encoder")
         if back_constrained and self.latent_prior:
             raise ValueError("latent_prior: the back-constrained latent points are a function of X, "
                              "not free points with a prior; use latent_prior=False")
+        from latentrl.recorded.sampling import farthest_points
+
+        chosen = np.zeros(0, dtype=np.intp) if inducing is None else farthest_points(start, inducing)
         fits: list[Any] = [
             minimise_back_constrained(z0, centred, log_theta, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
             if back_constrained else
             minimise_nll(z0, centred, log_theta, fit_latent=True, latent_prior=bool(self.latent_prior),
-                         noise_floor=noise_floor, max_iter=max_iter, tol=tol)
+                         noise_floor=noise_floor, max_iter=max_iter, tol=tol,
+                         inducing=None if inducing is None else z0[chosen])
             for z0 in starts
         ]
         best = min(fits, key=lambda fit: fit.nll)
@@ -240,13 +270,16 @@ class GPLVM(Estimator):
         self.converged_ = best.converged
         self.stop_reason_ = best.message
         self.jitter_ = best.jitter
+        self.inducing_index_ = chosen
+        self.inducing_ = np.zeros((0, start.shape[1])) if inducing is None else best.inducing
         if back_constrained:
             self.encoder_weights_ = best.weights
             encoder = GpMap.back_constraint(X, best.weights, best.log_beta)
             self.Z_ = encoder.predict_mean(X)  # K_b W of the raw postures: what transform gives
         else:
             self.encoder_weights_ = np.zeros_like(self.Z_)
-            encoder = fit_gp_encoder(X, self.Z_, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
+            encoder = fit_gp_encoder(X, self.Z_, noise_floor=noise_floor, max_iter=max_iter, tol=tol,
+                                     inducing=X[chosen] if inducing is not None else None)
         self.encoder_theta_ = np.array(encoder.theta)
         self.relevance_ = latent_relevance(self.Z_, self.theta_)
         self._build()
@@ -274,25 +307,43 @@ class GPLVM(Estimator):
         self._set_feature_names(names)
         return self
 
+    def _check_inducing(self, n: int) -> int | None:
+        """The `inducing` parameter for N = `n` postures: None, or an int in [1, n]."""
+        m = self.inducing
+        if m is None:
+            return None
+        if isinstance(m, bool) or not isinstance(m, int | np.integer) or not 1 <= m <= n:
+            raise ValueError(f"inducing must be None (the exact GPLVM) or an int m with 1 <= m <= the number of "
+                             f"postures ({n}), got {m!r}")
+        return int(m)
+
     def _build(self) -> None:
         self.log_likelihood_ = -self.nll_
-        self.decoder_ = GpMap(self.Z_, self.X_train_, self.theta_)
+        sparse = len(self.inducing_) > 0
+        self.decoder_ = GpMap(self.Z_, self.X_train_, self.theta_, inducing=self.inducing_ if sparse else None)
         if self.fitted_encoder_ == "back_constrained":
             log_beta = float(np.log(self.encoder_theta_[1]))
             self.encoder_ = GpMap.back_constraint(self.X_train_, self.encoder_weights_, log_beta)
         else:
-            self.encoder_ = GpMap(self.X_train_, self.Z_, self.encoder_theta_)
+            inducing_postures = self.X_train_[self.inducing_index_] if sparse else None
+            self.encoder_ = GpMap(self.X_train_, self.Z_, self.encoder_theta_, inducing=inducing_postures)
         from latentrl.inverse import Projection
 
-        self.projection_ = Projection(self.Z_, self.X_train_, self.theta_, self.decoder_.jitter)
-        self.native_projection_ = _native.Projection(self.decoder_, self.X_train_)
+        # A sparse decoder's points are the inducing inputs: the projection starts from the one
+        # whose decoded posture is nearest (the SciPy reference would be the exact O(N³) GP).
+        self._projection_postures = self.decoder_.predict_mean(self.inducing_) if sparse else self.X_train_
+        self.native_projection_ = _native.Projection(self.decoder_, self._projection_postures)
+        self.projection_: Projection | _native.Projection = (
+            self.native_projection_ if sparse
+            else Projection(self.Z_, self.X_train_, self.theta_, self.decoder_.jitter)
+        )
 
     @property
     def loop_encoder_(self) -> GpMap | _native.Projection:
         """The posture → Z map of the native RL loop, by the `encoder` parameter: `encoder_`,
         `native_projection_` for "projection", its tracking mode for "tracking"."""
         if self.encoder == "tracking":
-            return _native.Projection(self.decoder_, self.X_train_, tracking=True)
+            return _native.Projection(self.decoder_, self._projection_postures, tracking=True)
         return self.native_projection_ if self.encoder == "projection" else self.encoder_
 
     @property
@@ -303,10 +354,12 @@ class GPLVM(Estimator):
 
     def _restore(self, state: dict[str, Any]) -> None:
         # Files written before the back-constraint have no weights: their encoders had none;
-        # files written before n_components="auto" have no relevances: those of their own axes.
+        # files written before n_components="auto" have no relevances: those of their own axes;
+        # files written before the sparse GPLVM have no inducing inputs: they are exact.
         if "Z_" in state:
             Z = np.asarray(state["Z_"], dtype=np.float64)
-            state = {"encoder_weights_": np.zeros_like(Z), **state}
+            state = {"encoder_weights_": np.zeros_like(Z), "inducing_": np.zeros((0, Z.shape[1])),
+                     "inducing_index_": np.zeros(0, dtype=np.intp), **state}
             if "relevance_" not in state and "theta_" in state:
                 state["relevance_"] = latent_relevance(Z, np.asarray(state["theta_"], dtype=np.float64))
         super()._restore(state)

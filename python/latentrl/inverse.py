@@ -23,10 +23,12 @@ def fit_gp_encoder(
     noise_floor: float = 1e-6,
     max_iter: int = 1000,
     tol: float = 1e-6,
+    inducing: Array | None = None,
 ) -> GpMap:
     """GP regression from `postures` (N, D) to their `latent` points (N, d), SE kernel plus
     noise, θ by maximising the marginal likelihood (L-BFGS-B over log θ, θ3 ≥ `noise_floor`).
-    Its predictive mean is the encoder."""
+    Its predictive mean is the encoder. With `inducing` postures (m, D), the sparse (DTC) GP
+    through them: its bound gives θ, and the map is the sparse one."""
     centred = latent - latent.mean(axis=0)
     fit = minimise_nll(
         postures,
@@ -37,8 +39,9 @@ def fit_gp_encoder(
         noise_floor=noise_floor,
         max_iter=max_iter,
         tol=tol,
+        inducing=inducing,
     )
-    return GpMap(postures, latent, np.exp(fit.log_theta))
+    return GpMap(postures, latent, np.exp(fit.log_theta), inducing=inducing)
 
 
 class Projection:
