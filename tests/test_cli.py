@@ -278,6 +278,24 @@ def test_fit_auto_chooses_the_dimension_and_names_bad_values(tmp_path):
     assert not (tmp_path / "m.npz").exists()
 
 
+@pytest.mark.parametrize(("flags", "outcome"), [
+    (["--inducing", "8"], "fits"),
+    (["--inducing", "0"], "inducing must be None"),
+    (["--model", "pca", "--inducing", "8"], "--inducing: only --model gplvm"),
+])
+def test_fit_inducing_fits_the_sparse_gplvm(tmp_path, flags, outcome):
+    from latentrl import GPLVM, Demonstrations, save_demos
+    from latentrl.datasets import arm_postures
+
+    save_demos(Demonstrations(arm_postures(60, np.random.default_rng(0)), tuple("abcd")), tmp_path / "d.csv")
+    done = latentrl("fit", str(tmp_path / "d.csv"), *flags, "--max-iter", "30", "--out", str(tmp_path / "m.npz"))
+    if outcome != "fits":
+        assert done.returncode == 1 and outcome in done.stderr
+        return
+    assert done.returncode == 0 and json.loads(done.stdout)["inducing"] == 8, done.stderr
+    assert GPLVM.load(tmp_path / "m.npz").inducing_.shape == (8, 2)
+
+
 def test_fit_reports_bad_demonstration_files(tmp_path):
     result = latentrl("fit", str(tmp_path / "missing.csv"), "--out", str(tmp_path / "m.npz"))
     assert result.returncode == 1 and "missing.csv" in result.stderr

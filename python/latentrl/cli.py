@@ -249,6 +249,8 @@ def _fit_flags(fit: argparse.ArgumentParser) -> None:
                      help="latent dimension d, or auto (GPLVM: chosen by ARD relevance, docs/encoders.md; default: 2)")
     fit.add_argument("--seed", type=int, default=0, help="random_state of the GPLVM (default: 0)")
     fit.add_argument("--max-iter", type=int, default=1000, help="L-BFGS iteration cap of the GPLVM (default: 1000)")
+    fit.add_argument("--inducing", type=int, metavar="M", help="fit the sparse GPLVM through M inducing inputs, "
+                     "for many postures (docs/method.md#sparse-gplvm; default: the exact GPLVM, at most 16384 postures)")
     fit.add_argument("--out", type=Path, required=True, help="the model file to write (.npz; load with GPLVM.load)")
     _add_preset_flags(fit, DemoOptions)
 
@@ -503,6 +505,8 @@ def _fit(args: argparse.Namespace) -> int:
     if args.out.suffix != ".npz":
         raise ValueError(f"--out {args.out}: a model is saved as NPZ; give a file name ending in .npz")
     auto = args.n_components == "auto"
+    if args.inducing is not None and args.model == "pca":
+        raise ValueError("--inducing: only --model gplvm has inducing inputs")
     if auto and args.model == "pca":
         raise ValueError("--n-components auto: only --model gplvm chooses its dimension; give PCA an integer")
     given = {f.name: getattr(args, f.name) for f in dataclasses.fields(DemoOptions) if getattr(args, f.name) is not None}
@@ -511,7 +515,8 @@ def _fit(args: argparse.Namespace) -> int:
     if args.model == "pca":
         model: Any = PCA(n_components=args.n_components)
     else:
-        model = GPLVM(n_components=args.n_components, max_iter=args.max_iter, random_state=args.seed)
+        model = GPLVM(n_components=args.n_components, max_iter=args.max_iter, random_state=args.seed,
+                      inducing=args.inducing)
     model.fit(demos.postures)
     model.save(args.out)
     episodes = {} if demos.episodes is None else {"episodes": len(set(demos.episodes.tolist()))}
