@@ -67,6 +67,18 @@ def _posture_option(options: dict[str, Any] | None, n: int) -> Obs | None:
     return posture
 
 
+def _action(action: Any, n: int) -> Obs:
+    """`action` as n finite floats, or a ValueError naming it (issue #38: a NaN action was clipped
+    to NaN and stepped without a word; one of another length failed in NumPy's broadcasting)."""
+    try:
+        values = np.asarray(action, dtype=np.float64)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"action: expected {n} finite numbers, got {action!r} ({err})") from None
+    if values.shape != (n,) or not np.all(np.isfinite(values)):
+        raise ValueError(f"action: expected {n} finite numbers, got {values!r}")
+    return values
+
+
 def _info(end: int | None, reached: bool) -> dict[str, Any]:
     return {"end_reason": None if end is None else end_reasons()[end], "reached": reached}
 
@@ -185,7 +197,7 @@ class TaskEnv(gym.Env[Obs, Obs]):
         returns observation, reward, terminated (a rule broken), truncated (a success of the
         task's `target.hold_steps`: the episode is over, the state is not terminal) and info
         (``end_reason``, ``reached``)."""
-        delta = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
+        delta = np.clip(_action(action, len(self.joint_names)), -self.max_step, self.max_step)
         reward, end, _ = self.plant.step(self.action_origin + delta)
         success = end is not None and end_reasons()[end] == "success"
         info = _info(end, self.plant.reached())
@@ -273,7 +285,7 @@ class BimanualReachEnv(gym.Env[Obs, Obs]):
         """Moves the hands by `action` (clipped to ±`max_step`); returns observation, reward,
         terminated (obstacle, box exit or drop), truncated (never) and info (``end_reason``,
         ``reached``)."""
-        delta = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
+        delta = np.clip(_action(action, len(self.posture)), -self.max_step, self.max_step)
         reward, end = self.plant.step(self.posture + delta)
         return self.posture, float(reward), end is not None, False, _info(end, self.plant.reached())
 

@@ -191,7 +191,17 @@ def write_video(frames: Iterable[NDArray[np.uint8]], out: Path, fps: int) -> Non
     """Writes `frames` (at least one) to `out` (GIF or MP4 by suffix) as they come, through a
     temporary file, so a failed or interrupted write leaves nothing half-written. Memory stays
     bounded: an MP4's frames stream to ffmpeg (imageio's writer), a GIF keeps each frame
-    quantised to its 256-colour palette (Pillow, one byte per pixel) until it is saved."""
+    quantised to its 256-colour palette (Pillow, one byte per pixel) until it is saved. A write
+    that fails (a full disk) is an OSError naming `out` (issue #38)."""
+    try:
+        _write_video(frames, out, fps)
+    except OSError as err:
+        if err.filename is not None or str(out) in str(err):
+            raise
+        raise OSError(err.errno, f"cannot write {out}: {err.strerror or err}") from None
+
+
+def _write_video(frames: Iterable[NDArray[np.uint8]], out: Path, fps: int) -> None:
     with atomic_path(out) as temp:
         if out.suffix.lower() == ".gif":
             from PIL import Image
@@ -222,6 +232,30 @@ def run_setup(experiment: str, preset: Any, run_dir: Path) -> tuple[Any, Any, tu
     return module.task_of(preset), fit.model, (fit.low, fit.high)
 
 
+#: The arrays of returns.npz a replay reads, and their axes.
+REPLAY_ARRAYS = {"latent": ("trials", "episodes"), "latent_paths": ("trials", "episodes", "steps", "values"),
+                 "latent_test_paths": ("trials", "tests", "steps", "values"), "latent_weights": ("trials", "weights")}
+
+
+def check_replay_arrays(path: Path, arrays: dict[str, NDArray[Any]]) -> None:
+    """ValueError naming `path` and the array unless each array a replay reads (`REPLAY_ARRAYS`,
+    where present; `latent` always) is real-valued with its axes and one row per trial (issue #38:
+    a flattened array was an IndexError, strings a TypeError)."""
+    if "latent" not in arrays:
+        raise ValueError(f"{path}: no array 'latent' (not the returns.npz of a latent run)")
+    trials = None
+    for key, axes in REPLAY_ARRAYS.items():
+        if key not in arrays:
+            continue
+        value = arrays[key]
+        if value.dtype.kind not in "fiu" or value.ndim != len(axes):
+            raise ValueError(f"{path}: {key}: expected real numbers of shape ({', '.join(axes)}), got {value.dtype} "
+                             f"of shape {value.shape}")
+        trials = len(value) if trials is None else trials
+        if len(value) != trials:
+            raise ValueError(f"{path}: {key} has {len(value)} trials, 'latent' {trials}")
+
+
 def rollout_episode(out: Path, policy: str, trial: int, episode: int, view: str | None = None) -> Recorded:
     """Episode `episode` of trial `trial` of the `policy` ("greedy", "softmax", "random") rollout
     that `latentrl rollout` wrote into `out`, with the saved policy it names."""
@@ -237,14 +271,23 @@ def rollout_episode(out: Path, policy: str, trial: int, episode: int, view: str 
         raise ValueError(f"--trial {trial}: the rollout ran trials {trials}")
     moved = out / meta.get("policy_from_out", "")  # the rollout and its run moved together
     saved = LatentPolicy.load(moved if moved.is_file() else Path(meta["policy"]))
+    key, where = f"{policy}_paths", out / "rollout.npz"
     try:
-        arrays = read_npz(out / "rollout.npz", keys=[f"{policy}_paths"])
+        arrays = read_npz(where, keys=[key])
     except ValueError as err:
-        raise ValueError(f"{out / 'rollout.npz'}: {err}") from None
-    paths = arrays[f"{policy}_paths"][trials.index(trial)]
+        raise ValueError(f"{where}: {err}") from None
+    # Issue #38: a missing array was a KeyError, another shape an IndexError, NaN paths "need at least one array".
+    if key not in arrays:
+        raise ValueError(f"{where}: no array {key!r} (the rollout ran {', '.join(p for p in POLICIES if p in meta)})")
+    if arrays[key].dtype.kind != "f" or arrays[key].ndim != 4 or len(arrays[key]) != len(trials):
+        raise ValueError(f"{where}: {key}: expected floats of shape (trials {len(trials)}, episodes, steps, values), "
+                         f"got {arrays[key].dtype} of shape {arrays[key].shape}")
+    paths = arrays[key][trials.index(trial)]
     if not 0 <= episode < len(paths):
         raise ValueError(f"--episode {episode}: the rollout recorded episodes 0..{len(paths) - 1}")
     rows = paths[episode][np.isfinite(paths[episode]).all(axis=1)]
+    if len(rows) == 0:
+        raise ValueError(f"{where}: {key}: episode {episode} of trial {trial} has no finite stored step")
     title = f"{policy} rollout episode {episode} of trial {trial}"
     return robot_episode(saved.task, saved.model, saved.latent_low, saved.latent_high, rows, saved.weights[trial],
                          title, view, saved.demos)
@@ -264,7 +307,11 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     if (episode is None) == (test is None):
         raise ValueError("give one of --episode E (a recorded training episode) or --test T (a frozen test episode)")
     check_request(out, rerun, fps, width, max_frames, view)
-    arrays = load_arrays(run_dir)
+    try:
+        arrays = load_arrays(run_dir)
+    except ValueError as err:
+        raise ValueError(f"{run_dir / 'returns.npz'}: {err}") from None
+    check_replay_arrays(run_dir / "returns.npz", arrays)
     rows, what = episode_path(arrays, trial, episode, test, preset.episodes)
     weights = arrays.get("latent_weights")
     if weights is None:

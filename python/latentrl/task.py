@@ -132,6 +132,8 @@ class Task:
     def from_dict(cls, config: Mapping[str, Any], base_dir: str | Path = ".", origin: str = "<dict>") -> Task:
         """A task from a dict of task-file keys (nested tables as dicts); the URDF path is
         relative to `base_dir`."""
+        if not isinstance(config, Mapping):  # issue #38: a list said "dictionary update sequence element #0 …"
+            raise TypeError(f"{origin}: expected a table of task keys (a dict), got {type(config).__name__}")
         base = Path(base_dir)
         return cls(_native.Task.from_dict(dict(config), base, origin), base, frozenset(key_paths(config)))
 

@@ -53,6 +53,9 @@ class TrainPreset(LatentRun):
     def validate(self) -> None:
         """ValueError naming the first impossible field."""
         self.check_run()
+        # The trial streams take a 64-bit seed: checked here, before a folder is written (issue #38).
+        if self.seed > 2**64 - 1:
+            raise ValueError(f"seed must be an int in [0, 2**64 - 1], got {self.seed}")
 
     @classmethod
     def quick(cls) -> TrainPreset:
@@ -201,6 +204,13 @@ class LatentPolicy:
             if np.ndim(values) != 2 or len(values) != len(self.weights):
                 raise ValueError(f"record.{name}: expected (trials, episodes) with {len(self.weights)} trials, "
                                  f"got shape {np.shape(values)}")
+            if name.endswith("ends"):  # codes of end_reasons(), −1 after a trial stopped (issue #38)
+                codes = np.asarray(values)
+                count = len(end_reasons())
+                if codes.dtype.kind not in "iu" or codes.size and not (-1 <= codes.min() and codes.max() < count):
+                    raise ValueError(f"record.{name}: expected end codes, integers in -1..{count - 1}, got "
+                                     f"{codes.dtype} values in {codes.min() if codes.size else '-'}.."
+                                     f"{codes.max() if codes.size else '-'}")
         learner = task.to_dict()["learner"]
         self._native = [
             _native.LatentPolicy(learner, list(self.latent_low), list(self.latent_high), w, model.decoder_, model.loop_encoder_)
@@ -306,7 +316,11 @@ class LatentPolicy:
                    if k not in arrays]
         if missing:
             raise ValueError(f"{path}: not a complete policy file (missing {missing})")
-        task = Task.from_dict(json.loads(str(arrays["task"])), Path(str(arrays["task_dir"])), f"the task of {path}")
+        try:
+            keys = json.loads(str(arrays["task"]))
+        except ValueError as err:  # issue #38: the message names the file and the array
+            raise ValueError(f"{path}: its task is not valid JSON ({err})") from None
+        task = Task.from_dict(keys, Path(str(arrays["task_dir"])), f"the task of {path}")
         if task.digest() != str(arrays["task_digest"]):
             raise ValueError(f"{path}: its task (or the task's URDF in {arrays['task_dir']}) changed since it was saved")
         model = GPLVM._from_arrays({k[6:]: v for k, v in arrays.items() if k.startswith("model.")}, str(path))

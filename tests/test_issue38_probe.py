@@ -1,0 +1,125 @@
+"""Issue #38: regressions from the developers' hostile-input probe (tests/hostile_probe.py,
+docs/robustness.md#the-developers-hostile-input-probe): each input below once ended in a traceback,
+a message naming no file, or a half-written run folder."""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from latentrl import GPLVM, LatentPolicy
+from latentrl.datasets import arm_postures
+from latentrl.replay import check_replay_arrays, rollout_episode
+from latentrl.train import train_latent_policy
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+
+
+@pytest.fixture(scope="module")
+def policy_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    model = GPLVM(n_components=2, max_iter=50, random_state=0).fit(arm_postures(40, np.random.default_rng(1)))
+    policy = train_latent_policy(model, trials=1, episodes=2, overrides={"episode.max_steps": 10}, test_episodes=0)
+    path = tmp_path_factory.mktemp("policy") / "policy.npz"
+    policy.save(path)
+    return path
+
+
+def edited(policy_file: Path, tmp_path: Path, **arrays: np.ndarray) -> Path:
+    path = tmp_path / "edited.npz"
+    np.savez(path, **{**dict(np.load(policy_file)), **arrays})
+    return path
+
+
+def test_a_policy_whose_end_codes_are_unknown_is_refused_naming_the_file_and_array(policy_file: Path, tmp_path: Path) -> None:
+    """Issue #38: `latentrl report` on end codes 99 was an IndexError traceback (in `end_counts`)."""
+    ends = np.load(policy_file)["record.ends"]
+    for bad in (np.full_like(ends, 99), ends.astype(np.float64)):
+        with pytest.raises(ValueError, match=r"edited\.npz: record\.ends: expected end codes"):
+            LatentPolicy.load(edited(policy_file, tmp_path, **{"record.ends": bad}))
+
+
+def test_a_policy_whose_task_json_is_cut_is_refused_naming_the_file(policy_file: Path, tmp_path: Path) -> None:
+    """Issue #38: a cut task JSON said only "Unterminated string starting at …"."""
+    task = str(np.load(policy_file)["task"])
+    with pytest.raises(ValueError, match=r"edited\.npz: its task is not valid JSON"):
+        LatentPolicy.load(edited(policy_file, tmp_path, task=np.array(task[:40])))
+
+
+def test_a_seed_beyond_64_bits_is_refused_before_a_run_folder_is_written(tmp_path: Path) -> None:
+    """Issue #38: `latentrl train --seed 2**70` wrote the run folder, then failed in the native
+    runner ("base_seed must lie in …", not the flag's name)."""
+    out = tmp_path / "out"
+    result = subprocess.run(
+        [sys.executable, "-m", "latentrl", "train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"),
+         "--quick", "--trials", "1", "--episodes", "2", "--seed", str(2**70), "--out", str(out), "--no-progress"],
+        capture_output=True, text=True, timeout=300)
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert f"seed must be an int in [0, 2**64 - 1], got {2**70}" in result.stderr
+    assert not out.exists() or not any(out.iterdir())
+
+
+@pytest.mark.parametrize(("arrays", "says"), [
+    ({"latent": np.zeros((1, 4)), "latent_paths": np.zeros(24)}, r"latent_paths: expected real numbers of shape \(trials, episodes"),
+    ({"latent": np.zeros((1, 4)).astype(str)}, r"latent: expected real numbers .* got <U32"),
+    ({"latent": np.zeros((1, 4)), "latent_weights": np.zeros((2, 9))}, "latent_weights has 2 trials, 'latent' 1"),
+    ({"preset_json": np.array("{}")}, "no array 'latent'"),
+])
+def test_replay_refuses_run_arrays_of_another_shape_naming_the_file_and_array(arrays: dict[str, np.ndarray], says: str) -> None:
+    """Issue #38: a flattened `latent_paths` in returns.npz was an IndexError traceback in `latentrl replay`."""
+    with pytest.raises(ValueError, match=rf"^run/returns\.npz: .*{says}"):
+        check_replay_arrays(Path("run/returns.npz"), arrays)
+
+
+@pytest.mark.parametrize(("paths", "says"), [
+    (None, "no array 'greedy_paths'"),
+    (np.zeros(10), r"greedy_paths: expected floats of shape \(trials 1"),
+    (np.full((1, 2, 5, 3), np.nan), "greedy_paths: episode 0 of trial 0 has no finite stored step"),
+])
+def test_replay_of_a_rollout_refuses_broken_paths_naming_rollout_npz(policy_file: Path, tmp_path: Path, paths: np.ndarray | None,
+                                                                     says: str) -> None:
+    """Issue #38: `latentrl replay` of a rollout whose rollout.npz lost its paths was a KeyError
+    traceback; NaN paths said "need at least one array to stack"."""
+    (tmp_path / "rollout.json").write_text(json.dumps({"trials": [0], "greedy": {}, "policy": str(policy_file)}))
+    np.savez(tmp_path / "rollout.npz", **({} if paths is None else {"greedy_paths": paths}), other=np.zeros(1))
+    with pytest.raises(ValueError, match=rf"rollout\.npz: {says}"):
+        rollout_episode(tmp_path, "greedy", 0, 0)
+
+
+@pytest.mark.parametrize("action", [np.full(3, np.nan), np.zeros(2), [0.1, "x", 0.2]])
+def test_a_task_env_refuses_an_action_that_is_not_its_joints_finite_values(action: object) -> None:
+    """Issue #38: `TaskEnv.step` clipped a NaN action to NaN and stepped without a word; an action
+    of another length failed in NumPy's broadcasting, naming nothing."""
+    from latentrl import Task
+    from latentrl.envs import TaskEnv
+
+    env = TaskEnv(Task.load(EXAMPLE / "glass_arm.toml"))
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"^action: expected 3 finite numbers"):
+        env.step(action)  # type: ignore[arg-type]
+
+
+def test_a_video_that_cannot_be_written_names_its_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue #38: `latentrl replay --out` on a full disk said only "[Errno 28] No space left on device"."""
+    import errno
+
+    from latentrl import replay
+
+    def full(*args: object) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(replay, "_write_video", full)
+    with pytest.raises(OSError, match=rf"cannot write {re.escape(str(tmp_path / 'v.gif'))}: No space left on device"):
+        replay.write_video(iter([np.zeros((2, 2, 3), np.uint8)]), tmp_path / "v.gif", 10)
+
+
+def test_a_task_from_a_list_is_a_type_error_naming_its_origin() -> None:
+    """Issue #38: `Task.from_dict([1, 2], …)` said "cannot convert dictionary update sequence element #0"."""
+    from latentrl import Task
+
+    with pytest.raises(TypeError, match=r"^keys\.toml: expected a table of task keys \(a dict\), got list"):
+        Task.from_dict([1, 2], EXAMPLE, "keys.toml")  # type: ignore[arg-type]
