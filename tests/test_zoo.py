@@ -1,8 +1,8 @@
 """The robot zoo (examples/zoo/, issue #37 item 4): six robots and tasks nobody tuned. By default
 the fastest of them (the planar snake) is checked and trained with --quick end to end; the slow
-tests train every robot with the defaults and ask only that drawing from the learnt soft-max
-reaches the target in more rollouts than the random control from the same starts (a report of
-what the defaults do on robots nobody tuned them for, not a tuned threshold)."""
+tests train every robot with the defaults and ask for the issue's goal: the saved policy's greedy
+rollouts reach the target in ≥ 80 % of 40, the random control from the same starts in ≤ 30 %.
+Robots measured to miss it are expected failures, with the measured reason (examples/zoo/README.md)."""
 
 import json
 import subprocess
@@ -53,8 +53,19 @@ def test_the_fastest_zoo_robot_checks_trains_and_rolls_out(tmp_path):
         assert 0.0 <= result[policy]["reached_any_step"] <= 1.0
 
 
+MISSED = {
+    "snake_planar": "measured 39 % greedy (soft-max 48 %, random 9 %): its rollouts time out where V "
+                    "is flat, in latent regions far from the demos",
+    "iiwa_tray": "measured 11 % greedy: its target region spans 3 learner steps only at 1/16 RBF spacing, "
+                 "where 95 % of starts need 384 moves of the 200 an episode has (check: paths warning)",
+}
+"""The zoo robots that miss the goal with the defaults, and why (measured 2026-12-05; biped_pick
+met it, 85 % greedy, but trained in 54 min beside other runs, beyond the issue's 10 min)."""
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("robot", ROBOTS)
+@pytest.mark.parametrize("robot", [pytest.param(r, marks=pytest.mark.xfail(reason=MISSED[r])) if r in MISSED else r
+                                   for r in ROBOTS])
 def test_zoo_robot_learns_with_the_defaults(robot, tmp_path):
     task, demos = files(robot)
     run = tmp_path / robot
@@ -63,4 +74,4 @@ def test_zoo_robot_learns_with_the_defaults(robot, tmp_path):
     rollout = latentrl("rollout", run, "--out", run / "rollout", "--episodes", 20, "--no-progress")
     assert rollout.returncode == 0, rollout.stderr
     result = json.loads((run / "rollout" / "rollout.json").read_text())
-    assert result["softmax"]["reached_any_step"] > result["random"]["reached_any_step"], result
+    assert result["greedy"]["reached_any_step"] >= 0.8 and result["random"]["reached_any_step"] <= 0.3, result
