@@ -430,6 +430,9 @@ def check_format(arrays: Mapping[str, Any], expected: str, path: str) -> None:
                          f"{FORMAT_VERSION})")
 
 
+#: The largest |log θ| a sparse fit evaluates: e^±700 is still a finite, non-zero float.
+MAX_LOG_THETA = 700.0
+
 #: The most inputs whose pairwise distances `initial_log_theta` takes the median of.
 MEDIAN_SAMPLE = 4096
 
@@ -510,6 +513,10 @@ def minimise_nll(
         return gplvm_nll_grad(points[:n], data, lt, inducing=points[n:])
 
     def objective(params: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+        if inducing is not None and np.max(np.abs(params[-3:])) > MAX_LOG_THETA:
+            # The sparse bound's gradient grows with N: on 100k frames L-BFGS-B's line search
+            # tried log θ2 = −1254 (θ2 underflows to 0). A huge value makes it step back.
+            return 1e300, np.zeros_like(params)
         nll, grad_points, grad_lt, _ = evaluate(params)
         grad = np.concatenate([grad_points.ravel(), grad_lt]) if fit_latent else grad_lt
         if latent_prior:
