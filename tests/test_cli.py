@@ -233,6 +233,14 @@ def test_resume_refuses_flags_and_foreign_directories(tmp_path):
     (tmp_path / "results.json").write_text(json.dumps({"preset": {"name": "Exp1Preset", "trialz": 1}}))
     result = latentrl("run", "exp1", "--resume", str(tmp_path))
     assert result.returncode == 1 and "does not know: ['trialz']" in result.stderr
+    # Issue #38: a results.json of the wrong structure, or nested past the parser, named as such.
+    for payload, message in ((json.dumps({"preset": "Exp1Preset"}), "preset must be a JSON object, got str"),
+                             (json.dumps({"setup": {"inputs": {"demos": 3}}}), "setup.inputs['demos'] must be"),
+                             ("[" * 100_000 + "]" * 100_000, "nested too deeply")):
+        (tmp_path / "results.json").write_text(payload)
+        result = latentrl("run", "exp1", "--resume", str(tmp_path))
+        assert result.returncode == 1 and f"{tmp_path / 'results.json'}: {message}" in result.stderr, result.stderr
+        assert "Traceback" not in result.stderr
 
 
 @pytest.mark.parametrize("model", ["gplvm", "pca"])

@@ -39,12 +39,13 @@ def saved_run(out_dir: Path, *, train: bool = False) -> tuple[str, Any]:
     also ("train", its TrainRun) for a `latentrl train` directory; ValueError if the directory
     holds none, or the preset does not fit this version."""
     from latentrl.experiments.registry import experiments
-    from latentrl.experiments.results import read_json
+    from latentrl.experiments.results import read_results
 
     meta_path = out_dir / "results.json"
     if not meta_path.is_file():
         raise ValueError(f"{out_dir}: no results.json there, so no run of an RL experiment")
-    fields = dict(read_json(meta_path).get("preset") or {})
+    meta = read_results(meta_path)
+    fields = dict(meta.get("preset") or {})
     preset_name = fields.pop("name", None)
     known = [(name, exp.preset) for name, exp in experiments().items() if exp.rl]
     if train:
@@ -59,7 +60,7 @@ def saved_run(out_dir: Path, *, train: bool = False) -> tuple[str, Any]:
     if unknown:
         raise ValueError(f"{out_dir}: its preset has fields this version does not know: {unknown}")
     preset = preset_cls(**fields)
-    recorded = read_json(meta_path).get("setup", {}).get("task")
+    recorded = meta.get("setup", {}).get("task")
     if name == "train" or recorded is None:
         return name, preset
     return name, _as_recorded(out_dir, name, preset, recorded)

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl.experiments.presets import latent_box
-from latentrl.experiments.results import as_saved, read_json
+from latentrl.experiments.results import as_saved, read_results
 from latentrl.experiments.runner import MODEL_FILE, RunTrials, Setup
 from latentrl.gplvm import GPLVM
 from latentrl.task import Task
@@ -56,7 +56,7 @@ def run_fit(run: Path | str | None, margin: float, refit: Callable[[], Fitted]) 
     model_path = meta_path.parent / MODEL_FILE
     kept = model_path.exists()
     fitted = Fitted.of_model(GPLVM.load(model_path), margin) if kept else refit()
-    saved, now = read_json(meta_path).get("setup", {}).get("gplvm"), as_saved(gplvm_info(fitted.model))
+    saved, now = read_results(meta_path).get("setup", {}).get("gplvm"), as_saved(gplvm_info(fitted.model))
     if saved is not None and saved != now:
         source = f"{model_path} (nll {now['nll']})" if kept else (
             f"the GPLVM refitted on this machine (nll {now['nll']}; the run has no {MODEL_FILE}, and another CPU "

@@ -54,11 +54,33 @@ def read_json(path: Path) -> dict[str, Any]:
         payload = json.loads(read_text(path, MAX_JSON_BYTES, "a JSON file of a run"))
     except json.JSONDecodeError as err:
         raise ValueError(f"{path}: not valid JSON ({err})") from err
+    except RecursionError:
+        raise ValueError(f"{path}: nested too deeply to be a latentrl file") from None
     except ValueError as err:
         raise ValueError(f"{path}: {err}") from None
     if not isinstance(payload, dict):
         raise ValueError(f"{path}: expected a JSON object at the top level")
     return payload
+
+
+RESULTS_OBJECTS = {"": ("preset", "setup", "trials", "environment"), "setup.": ("task", "gplvm", "inputs", "latent_box")}
+"""The parts of a results.json that readers use, by where they sit: each must be a JSON object."""
+
+
+def read_results(path: Path) -> dict[str, Any]:
+    """A run's results.json (`read_json`) whose parts in `RESULTS_OBJECTS` are objects and whose
+    recorded input digests are strings: a ValueError naming the file and the field otherwise."""
+    meta = read_json(path)
+    for prefix, keys in RESULTS_OBJECTS.items():
+        parent = meta.get(prefix[:-1], {}) if prefix else meta
+        for key in keys:
+            if key in parent and not isinstance(parent[key], dict):
+                raise ValueError(f"{path}: {prefix}{key} must be a JSON object, got {type(parent[key]).__name__}")
+    inputs = meta.get("setup", {}).get("inputs", {})
+    bad = [name for name, digest in inputs.items() if not isinstance(digest, str)]
+    if bad:
+        raise ValueError(f"{path}: setup.inputs[{bad[0]!r}] must be a SHA-256 string")
+    return meta
 
 
 def _to_plain(value: Any) -> Any:

@@ -26,7 +26,7 @@ from latentrl.experiments.results import (
     as_saved,
     environment,
     peak_rss_mib,
-    read_json,
+    read_results,
     remove_stale_temporaries,
     worker_threads,
     write_json,
@@ -275,7 +275,7 @@ def _previous(
         remove_stale_temporaries(path)
     if not meta_path.exists():
         return {}, None
-    meta = read_json(meta_path)
+    meta = read_results(meta_path)
     recorded = meta.get("setup", {}).get("task")
     ran = ran_with(recorded) if recorded is not None else {}
     if _edited(meta.get("preset") or {}, as_saved(plan), ran):

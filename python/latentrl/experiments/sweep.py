@@ -35,7 +35,7 @@ from latentrl.run_lock import run_lock
 from latentrl.experiments.presets import describe
 from latentrl.experiments.ray_backend import RayBackend
 from latentrl.experiments.registry import RlExperiment, rl_experiments
-from latentrl.experiments.results import environment, read_json, worker_threads, write_json
+from latentrl.experiments.results import environment, read_json, read_results, worker_threads, write_json
 from latentrl.experiments.runner import Setup, load_arrays, run_in_process, run_rl
 from latentrl.experiments.sweep_types import Cell, Job, Sweep, SweepError, load_sweep
 
@@ -212,7 +212,7 @@ def _trials_done(kind: RlExperiment, cell: Cell, out: Path) -> int:
     if not (meta_path.exists() and (out / "returns.npz").exists()):
         return 0
     try:
-        if read_json(meta_path).get("preset") != json.loads(json.dumps(describe(cell.preset))):
+        if read_results(meta_path).get("preset") != json.loads(json.dumps(describe(cell.preset))):
             return 0
         arrays = load_arrays(out)
     except ValueError:

@@ -78,7 +78,7 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
     margin)."""
     from latentrl.derive import applied, derive
     from latentrl.experiments.latent_runs import Fitted, run_fit
-    from latentrl.experiments.results import read_json
+    from latentrl.experiments.results import read_results
     from latentrl.experiments.runner import check_inputs
 
     overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
@@ -89,7 +89,7 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
         model = run_fit(out, run.latent_margin, lambda: Fitted.of_model(model, run.latent_margin)).model
         meta = Path(out) / "results.json"
         if meta.is_file():  # a run read back (resume, replay, rollout, plot): made from these inputs?
-            recorded = read_json(meta).get("setup", {}).get("inputs") or {}
+            recorded = read_results(meta).get("setup", {}).get("inputs") or {}
             check_inputs(recorded, input_digests(run.task_file, task, demos, model), Path(out))
     fit = hashlib.sha256(np.ascontiguousarray(model.Z_).tobytes() + np.ascontiguousarray(demos).tobytes())
     key = (task.digest(), fit.hexdigest(), task.given, run.latent_margin)
