@@ -88,6 +88,14 @@ def test_the_readme_commands_train_save_and_roll_out(runs):
     assert (runs["learner"] / "policy.npz").is_file() and (runs["learner"] / "returns.png").is_file()
 
 
+def test_plot_redraws_a_train_runs_figures(runs, tmp_path):
+    """Issue #38's probe: `latentrl plot` refused a train run ("names no RL experiment's preset")."""
+    result = subprocess.run([sys.executable, "-m", "latentrl", "plot", str(runs["learner"]), "--out", str(tmp_path)],
+                            capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert {"returns.png", "value_after.png", "failures.png"} <= {p.name for p in tmp_path.iterdir()}
+
+
 def test_rollout_runs_the_policies_asked_for_and_a_success_rule_ends_episodes(runs, tmp_path):
     assert cli.main(["rollout", str(runs["learner"]), "--out", str(tmp_path), "--episodes", "3", "--policy",
                      "softmax", "--starts", "train", "--no-progress"]) == 0

@@ -257,7 +257,7 @@ def _fit_flags(fit: argparse.ArgumentParser) -> None:
 
 
 def _plot_flags(plot: argparse.ArgumentParser) -> None:
-    plot.add_argument("results", type=Path, help="a results directory of `latentrl run exp1|exp2|exp3`")
+    plot.add_argument("results", type=Path, help="a results directory of `latentrl run exp1|exp2|exp3` or `latentrl train`")
     plot.add_argument("--out", type=Path, help="where to write the figures (default: the results directory)")
 
 
@@ -534,14 +534,19 @@ def _plot(args: argparse.Namespace) -> int:
     from latentrl.experiments.registry import experiments
     from latentrl.experiments.runner import finished_trials, load_arrays
 
-    name, preset = saved_run(args.results)
+    name, preset = saved_run(args.results, train=True)
     arrays, done = finished_trials(load_arrays(args.results))
     if not done:
         raise ValueError(f"{args.results}: no finished trial to plot")
-    rl = experiments()[name].rl
-    assert rl is not None  # saved_run finds RL experiments only
     out = args.out or args.results
-    rl.figures(preset, arrays, args.results, out)
+    if name == "train":
+        from latentrl.experiments.training_run import figures
+
+        figures(preset, arrays, args.results, out)
+    else:
+        rl = experiments()[name].rl
+        assert rl is not None  # saved_run finds RL experiments only
+        rl.figures(preset, arrays, args.results, out)
     counts = ", ".join(f"{learner} {n} of {preset.trials}" for learner, n in done.items())
     print(f"figures of {name} ({counts} trials) in {out}")
     return 0
