@@ -208,3 +208,19 @@ def test_the_failures_figure_shows_the_last_episodes_a_stopped_trial_ran(monkeyp
               "latent_mean_state": means, "latent_weights": np.zeros((1, 4))}
     training_run.failures(arrays, "stopped", np.zeros(2), np.ones(2), None, {}, tmp_path)
     assert titles == ["stopped: where the last 100 episodes of trial 0 failed (100)"]
+
+
+def test_a_run_reads_back_under_a_version_with_a_new_model_parameter(runs, monkeypatch):
+    """Issue #38: a run's GPLVM is identified by the arrays its gplvm.npz holds, not by how this
+    version would write them: a parameter added since (here `future`, None) is not a changed
+    model (the sparse GPLVM's `inducing` made every earlier train run "changed since the run")."""
+    from latentrl import GPLVM
+    from latentrl.experiments.results import read_results
+    from latentrl.experiments.training import TrainRun, prepared
+
+    out = runs["learner"]
+    fields = dict(read_results(out / "results.json")["preset"])
+    fields.pop("name")
+    get_params = GPLVM.get_params
+    monkeypatch.setattr(GPLVM, "get_params", lambda self, deep=True: {**get_params(self, deep), "future": None})
+    prepared(TrainRun(**fields), out)  # raised "its model changed since the run"

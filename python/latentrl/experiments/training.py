@@ -9,10 +9,12 @@ import json
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from latentrl._base import read_npz
 from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded
 from latentrl.demos import load_demos
 from latentrl.recorded import recording_kind
@@ -79,7 +81,7 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
     from latentrl.derive import applied, derive
     from latentrl.experiments.latent_runs import Fitted, run_fit
     from latentrl.experiments.results import read_results
-    from latentrl.experiments.runner import check_inputs
+    from latentrl.experiments.runner import MODEL_FILE, check_inputs
 
     overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
     options = DemoOptions(**{f.name: getattr(run, f.name) for f in dataclasses.fields(DemoOptions)})
@@ -90,7 +92,8 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
         meta = Path(out) / "results.json"
         if meta.is_file():  # a run read back (resume, replay, rollout, plot): made from these inputs?
             recorded = read_results(meta).get("setup", {}).get("inputs") or {}
-            check_inputs(recorded, input_digests(run.task_file, task, demos, model), Path(out))
+            saved = read_npz(Path(out) / MODEL_FILE) if (Path(out) / MODEL_FILE).is_file() else model._arrays()
+            check_inputs(recorded, input_digests(run.task_file, task, demos, saved), Path(out))
     fit = hashlib.sha256(np.ascontiguousarray(model.Z_).tobytes() + np.ascontiguousarray(demos).tobytes())
     key = (task.digest(), fit.hexdigest(), task.given, run.latent_margin)
     if key not in _DERIVED:
@@ -112,23 +115,23 @@ def setup(run: TrainRun, out: Path | None = None) -> Setup:
     task, demos, model, settings = prepared(run, out)
     built = latent_setup(run, task, model, latent_box(model.Z_, run.latent_margin), demos)
     built.info["derived"] = [d.to_dict() for d in settings]
-    built.info["inputs"] = input_digests(run.task_file, task, demos, model)
+    built.info["inputs"] = input_digests(run.task_file, task, demos, model._arrays())
     return built
 
 
-def input_digests(task_file: str, task: Task, demos: np.ndarray, model: GPLVM) -> dict[str, str]:
+def input_digests(task_file: str, task: Task, demos: np.ndarray, model: Mapping[str, np.ndarray]) -> dict[str, str]:
     """SHA-256 of what a run is made from: the task file's and the URDF's bytes, the demo
-    postures as the learner gets them (joint order, float64) and the GPLVM's arrays; a resume
-    compares them (`runner.check_inputs`)."""
+    postures as the learner gets them (joint order, float64) and the GPLVM's arrays as saved
+    (`model`: a run's gplvm.npz as read, so a parameter a later version adds does not change
+    it); a resume compares them (`runner.check_inputs`)."""
     def sha(data: bytes) -> str:
         return hashlib.sha256(data).hexdigest()
 
-    arrays = model._arrays()
     return {
         "task file": sha(read_bounded(task_file, MAX_TASK_FILE_BYTES, "a task file")),
         "urdf": sha(read_bounded(task.urdf_path, MAX_URDF_BYTES, "a URDF")),
         "demos": sha(np.ascontiguousarray(demos, dtype=np.float64).tobytes()),
-        "model": sha(b"".join(k.encode() + np.ascontiguousarray(arrays[k]).tobytes() for k in sorted(arrays))),
+        "model": sha(b"".join(k.encode() + np.ascontiguousarray(model[k]).tobytes() for k in sorted(model))),
     }
 
 
