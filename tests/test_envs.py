@@ -59,6 +59,21 @@ def test_check_env(env_id):
     env.close()
 
 
+def test_rgb_array_frames_take_a_view():
+    """Issue #41: a TaskEnv's frames in the view it is given (here the humanoid, side by default,
+    from the top and in 3-D), the same size; a view that does not exist is refused up front."""
+    frames = {}
+    for view in (None, "top", "3d"):
+        env = gym.make("latentrl/HumanoidLift-v0", render_mode="rgb_array", view=view)
+        env.reset(seed=0)
+        frames[view] = env.unwrapped.render()
+        env.close()
+    assert frames[None].shape == frames["top"].shape == frames["3d"].shape
+    assert (frames[None] != frames["top"]).any() and (frames["top"] != frames["3d"]).any()
+    with pytest.raises(ValueError, match="view must be one of top, side, front, 3d, got 'iso'"):
+        TaskEnv("two_arms", view="iso")
+
+
 @pytest.mark.parametrize("env_id", IDS)
 def test_same_seed_same_episode(env_id):
     def rollout():

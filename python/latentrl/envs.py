@@ -116,7 +116,8 @@ class TaskEnv(gym.Env[Obs, Obs]):
     ## Arguments
     `task` (a Task or a shipped task's name), `demos` (N, D; default: the shipped demos of a
     shipped task, none otherwise), `max_step` (0.1 rad), `reach` (1 m, the observation bound of
-    effector coordinates), `render_mode` (`None` or `"rgb_array"`).
+    effector coordinates), `render_mode` (`None` or `"rgb_array"`), `view` (the frames' view:
+    "top", "side", "front" or "3d", `latentrl.render.VIEWS`; default: chosen as `render` says).
     """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 20}
@@ -128,7 +129,11 @@ class TaskEnv(gym.Env[Obs, Obs]):
         max_step: float = 0.1,
         reach: float = 1.0,
         render_mode: str | None = None,
+        view: str | None = None,
     ) -> None:
+        from latentrl.render import checked_view
+
+        self.view = None if view is None else checked_view(view)
         if isinstance(task, str):
             if demos is None and task in SHIPPED_DEMOS:
                 demos = shipped_demos(task)
@@ -205,13 +210,14 @@ class TaskEnv(gym.Env[Obs, Obs]):
 
     def render(self) -> NDArray[np.uint8] | None:
         """An RGB image (H, W, 3) of the robot's links, the target and the floor if `render_mode`
-        is ``"rgb_array"``, else None: the x–z side view of a floating robot; for a fixed one the plane
-        its links and target spread over most (`latentrl.render.view_axes`)."""
+        is ``"rgb_array"``, else None: in the env's `view`, or by default the x–z side view of a
+        floating robot and, for a fixed one, the plane its links and target spread over most
+        (`latentrl.render.view_axes`)."""
         if self.render_mode != "rgb_array":
             return None
         from latentrl.render import draw_task
 
-        return draw_task(self.task, self.plant)
+        return draw_task(self.task, self.plant, view=self.view)
 
 
 class BimanualReachEnv(gym.Env[Obs, Obs]):

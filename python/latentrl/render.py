@@ -49,15 +49,20 @@ default azimuth: x runs to the lower right, y to the upper right, z up), fixed s
 frame of a video and every image of a task is seen from the same place."""
 
 
+def checked_view(view: str) -> str:
+    """`view` if it names one of `VIEWS`, else a ValueError listing them."""
+    if view not in VIEWS:
+        raise ValueError(f"view must be one of {', '.join(VIEWS)}, got {view!r}")
+    return view
+
+
 def view_axes(task: Task, points: NDArray[np.float64], target: NDArray[np.float64], view: str | None = None) -> tuple[int, ...]:
     """The world axes drawn: `view`'s (`VIEWS`), or by default the side view (x–z) of a floating
     robot and, for a fixed one, the two axes along which its links (`points`, (K, 3): where they
     are, or go over an episode) and the target spread most: a planar arm in its plane, an arm that
     lifts from the side, so the motion that matters is seen."""
     if view is not None:
-        if view not in VIEWS:
-            raise ValueError(f"view must be one of {', '.join(VIEWS)}, got {view!r}")
-        return VIEWS[view]
+        return VIEWS[checked_view(view)]
     if task.to_dict()["root"] == "floating":
         return VIEWS["side"]
     every = np.vstack([points[np.isfinite(points).all(axis=1)], target])
