@@ -177,6 +177,10 @@ def test_demos_of_another_robot_are_refused_by_column(tmp_path):
     result = latentrl(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(csv), "--out", str(tmp_path / "o"),
                        "--learner.gamma", "1.5"])
     assert result.returncode == 1 and "learner.gamma must lie in [0, 1), got 1.5" in result.stderr
+    csv.write_text("shoulder,elbow,wrist\n" + "0.1,0.2,0.3\n" * 20)  # issue #38's probe: the file was not named
+    result = latentrl(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(csv), "--out", str(tmp_path / "i")])
+    assert result.returncode == 1 and f"{csv}: X: all 20 postures are identical" in result.stderr, result.stderr
+    assert not (tmp_path / "i").exists()
 
 
 def test_a_task_with_move_corrections_trains_draws_and_saves(tmp_path):

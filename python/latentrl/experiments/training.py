@@ -63,7 +63,10 @@ def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, mode
         if gplvm.n_features_in_ != len(task.joint_names):
             raise ValueError(f"{model}: fitted to {gplvm.n_features_in_} joints, the task's robot has {len(task.joint_names)}")
     else:
-        gplvm.fit(postures)
+        try:
+            gplvm.fit(postures)
+        except ValueError as err:  # e.g. identical postures: say which file holds them
+            raise ValueError(f"{demos}: {err}") from err
     return task, postures, gplvm
 
 
