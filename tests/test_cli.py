@@ -23,6 +23,15 @@ def latentrl(*args, timeout=300):
     )
 
 
+def test_info_on_a_full_disk_says_so_in_one_line():
+    """Issue #38's probe: `latentrl info > /dev/full` was an OSError traceback."""
+    with open("/dev/full", "w") as full:
+        result = subprocess.run([sys.executable, "-m", "latentrl", "info"], stdout=full, stderr=subprocess.PIPE,
+                                text=True)
+    assert result.returncode == 1 and "Traceback" not in result.stderr
+    assert result.stderr.strip() == "latentrl: error: cannot write to standard output: No space left on device"
+
+
 def test_info_prints_versions_git_revision_and_threads_as_json():
     """What the README promises of `latentrl info`: versions, git revision, thread count."""
     result = latentrl("info")

@@ -603,6 +603,18 @@ def _urdf_info(args: argparse.Namespace) -> int:
     return 0
 
 
+def _info(args: argparse.Namespace) -> int:
+    from latentrl.experiments.results import environment
+
+    text = json.dumps(environment(), indent=2)
+    try:
+        print(text, flush=True)
+    except OSError as err:  # e.g. stdout a full disk: say so once, not again at exit's flush
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        raise OSError(f"cannot write to standard output: {err.strerror}") from None
+    return 0
+
+
 def _check_writable(out: Path, *, file: bool) -> None:
     """`--out` can be written: its nearest existing ancestor is a writable directory (and it is
     not a directory where a file goes, or a file where a directory goes). Checked before any
@@ -623,12 +635,7 @@ RECORDING_LIBRARIES = ("pyarrow", "h5py", "rosbags")
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
     args = build_parser().parse_args(argv)
-    if args.command == "info":
-        from latentrl.experiments.results import environment
-
-        print(json.dumps(environment(), indent=2))
-        return 0
-    command = {"run": _run, "train": _train, "check": _check, "report": _report, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep,
+    command = {"info": _info, "run": _run, "train": _train, "check": _check, "report": _report, "rollout": _rollout, "fit": _fit, "plot": _plot, "sweep": _sweep,
                "urdf-info": _urdf_info, "replay": _replay}
     try:
         out = getattr(args, "out", None)
