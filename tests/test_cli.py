@@ -346,3 +346,23 @@ def test_plot_redraws_the_finished_trials_of_a_partial_run(tmp_path):
         assert (tmp_path / "figs" / f"{fig}.png").stat().st_size > 1000
     result = latentrl("plot", str(tmp_path / "figs"))
     assert result.returncode == 1 and "no results.json" in result.stderr
+
+
+def test_resume_names_what_is_wrong_with_returns_npz(tmp_path):
+    """Issue #38's probe: a returns.npz without an array was a KeyError traceback, one of strings a
+    TypeError traceback, one that is not a zip a message without the file."""
+    out = tmp_path / "run"
+    first = latentrl("run", "exp1", "--no-progress", *TINY_RUNS["exp1"], "--out", str(out))
+    assert first.returncode == 0, first.stderr
+    saved = dict(np.load(out / "returns.npz"))
+    edits = {"latent_end missing": ({k: v for k, v in saved.items() if k != "latent_end"}, "latent_end is missing"),
+             "strings": ({**saved, "latent": saved["latent"].astype(str)}, "latent holds <U"),
+             "not a zip": (None, "not a readable NPZ file")}
+    for name, (arrays, message) in edits.items():
+        if arrays is None:
+            (out / "returns.npz").write_bytes(b"hello")
+        else:
+            np.savez(out / "returns.npz", **arrays)
+        result = latentrl("run", "exp1", "--no-progress", "--resume", str(out))
+        assert result.returncode == 1 and "Traceback" not in result.stderr, (name, result.stderr)
+        assert f"{out / 'returns.npz'}: " in result.stderr and message in result.stderr, (name, result.stderr)

@@ -307,10 +307,7 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     if (episode is None) == (test is None):
         raise ValueError("give one of --episode E (a recorded training episode) or --test T (a frozen test episode)")
     check_request(out, rerun, fps, width, max_frames, view)
-    try:
-        arrays = load_arrays(run_dir)
-    except ValueError as err:
-        raise ValueError(f"{run_dir / 'returns.npz'}: {err}") from None
+    arrays = load_arrays(run_dir)  # its errors name the file
     check_replay_arrays(run_dir / "returns.npz", arrays)
     rows, what = episode_path(arrays, trial, episode, test, preset.episodes)
     weights = arrays.get("latent_weights")

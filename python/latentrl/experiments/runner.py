@@ -334,7 +334,9 @@ def _check_continued(meta: Mapping[str, Any], built: Setup, arrays: Mapping[str,
     for name in built.learners:
         for what in PER_EPISODE:
             key = array_key(name, what)
-            if key in arrays and arrays[key].shape != want:
+            if key not in arrays:
+                raise ValueError(f"{out}/returns.npz: {key} is missing; restore the file, or start a new run with --out")
+            if arrays[key].shape != want:
                 raise ValueError(f"{out}/returns.npz: {key} has shape {arrays[key].shape}, the preset asks for "
                                  f"{want} (trials, episodes); it belongs to another run")
 
@@ -350,8 +352,17 @@ def check_inputs(recorded: Mapping[str, str], now: Mapping[str, str], out: Path)
 
 
 def load_arrays(out_dir: Path | str) -> dict[str, np.ndarray]:
-    """Every array of a results directory's returns.npz (a ValueError if it is not readable)."""
-    return read_npz(Path(out_dir) / "returns.npz")
+    """Every array of a results directory's returns.npz: a ValueError naming the file if it is not
+    readable or an array (but the preset's JSON) holds anything but numbers."""
+    path = Path(out_dir) / "returns.npz"
+    try:
+        arrays = read_npz(path)
+    except ValueError as err:
+        raise ValueError(f"{path}: {err}") from None
+    for key, value in arrays.items():
+        if key != PRESET_KEY and value.dtype.kind not in "biuf":
+            raise ValueError(f"{path}: {key} holds {value.dtype} values, expected numbers")
+    return arrays
 
 
 def finished_trials(arrays: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
