@@ -123,3 +123,24 @@ def test_a_task_from_a_list_is_a_type_error_naming_its_origin() -> None:
 
     with pytest.raises(TypeError, match=r"^keys\.toml: expected a table of task keys \(a dict\), got list"):
         Task.from_dict([1, 2], EXAMPLE, "keys.toml")  # type: ignore[arg-type]
+
+
+def test_demos_in_degrees_are_refused_naming_the_file_posture_and_joint(tmp_path: Path) -> None:
+    """Issue #38: postures at 9 rad (limits ±3.1) ended in "latent_high[1] = 0 must exceed
+    latent_low[1] = 0", naming neither the demo file nor the joint."""
+    lines = (EXAMPLE / "demos.csv").read_text().splitlines()
+    header, rows = lines[0], [list(map(float, line.split(","))) for line in lines[1:]]
+    rows[3][1] = 9.0
+    demos = tmp_path / "demos.csv"
+    demos.write_text("\n".join([header, *(",".join(map(repr, r)) for r in rows)]) + "\n")
+    joint = header.split(",")[1]
+    out = tmp_path / "out"
+    for command in ("train", "check"):
+        result = subprocess.run(
+            [sys.executable, "-m", "latentrl", command, str(EXAMPLE / "glass_arm.toml"), "--demos", str(demos), "--quick",
+             "--no-progress", *(["--out", str(out)] if command == "train" else [])],
+            capture_output=True, text=True, timeout=300)
+        assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
+        assert f"{demos}: posture 3 (counting from 0) has {joint} = 9" in result.stderr
+        assert "look like degrees" in result.stderr
+    assert not out.exists() or not any(out.iterdir())

@@ -38,13 +38,10 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl.physics_check import HOLD_S, servo_error, servo_tolerance
-from latentrl.task import Task, end_reasons
+from latentrl.task import DEGREES, Task, end_reasons
 
 VERDICTS = ("ok", "warning", "will not learn")
 """Each finding's verdict, mildest first."""
-
-DEGREES = 2 * np.pi + 1e-6
-"""A joint angle beyond ±2π rad is taken for degrees (no robot joint here turns more than once)."""
 
 BROKEN_SHARE = 0.2
 """Demo rows that break a constraint at rest ("drop"): "will not learn" from this share on, since

@@ -25,6 +25,10 @@ from numpy.typing import NDArray
 from latentrl import _native
 from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded, read_text
 
+DEGREES = 2 * np.pi + 1e-6
+"""A joint angle beyond ±2π rad and outside its joint's limits is taken for degrees (no limited
+robot joint turns more than once): `Task.demo_postures` refuses it, `latentrl check` names it."""
+
 SHIPPED = ("two_arms", "humanoid_lift")
 """The task files shipped in `latentrl/tasks/`: Experiment 2's arms and Experiment 3's lift."""
 
@@ -190,7 +194,23 @@ class Task:
             columns = _native.demo_columns(self.urdf_path, list(joint_names), rows)
         except ValueError as err:  # InvalidInputError stays one
             raise type(err)(f"{where}: {err}") from err
-        return rows[:, columns]
+        chosen = rows[:, columns]
+        self._refuse_degrees(chosen, where)
+        return chosen
+
+    def _refuse_degrees(self, postures: NDArray[np.float64], where: str) -> None:
+        """ValueError naming `where`, the first such posture and its joint when a value lies beyond
+        ±2π rad and outside its joint's limits (`DEGREES`)."""
+        beyond = (np.abs(postures) > DEGREES) & ((postures < self.lower) | (postures > self.upper))
+        if not beyond.any():
+            return
+        rows, columns = np.nonzero(beyond)
+        joint, value = self.joint_names[columns[0]], postures[rows[0], columns[0]]
+        lower, upper = self.lower[columns[0]], self.upper[columns[0]]
+        raise ValueError(
+            f"{where}: posture {rows[0]} (counting from 0) has {joint} = {value:.6g}, beyond ±2π and outside the "
+            f"joint's limits [{lower:.6g}, {upper:.6g}] ({len(np.unique(rows))} of {len(postures)} postures like "
+            "it): these look like degrees; write the demonstrations in radians (np.deg2rad)")
 
     @property
     def warnings(self) -> list[str]:
