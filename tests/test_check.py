@@ -150,7 +150,7 @@ def test_the_step_keeps_the_path_within_half_an_episode():
 
     def surveys(spans: dict[float, float], moves: dict[float, int]):
         def at(step: float) -> dict:
-            reached = round(spans[step] ** 2)  # _span: the side of a square of reached points, stride 1
+            reached = round(spans[step] ** 2)  # derive.region_span: the side of a square of reached points, stride 1
             return {"reached": np.ones(reached, bool), "shape": (10, 10), "stride": 1,
                     "moves": np.full(20, moves[step])}
         return at

@@ -11,7 +11,7 @@ import sys
 from pathlib import Path
 
 from latentrl import GPLVM, Task, load_demos
-from latentrl.derive import STEPS, _moves95, _span, _survey, applied, servo_gains
+from latentrl.derive import STEPS, applied, moves95, region_span, servo_gains, survey_at_step
 from latentrl.experiments.presets import latent_box
 from latentrl.train import TrainPreset
 
@@ -26,6 +26,6 @@ for robot in sys.argv[1:] or sorted(p.parent.name for p in HERE.glob("*/task.tom
     if not any(key.startswith("servo.") for key in task.given):
         task = applied(task, servo_gains(task, demos))
     for step in STEPS:
-        survey = _survey(task.replace({"learner.step": step}), model, low, high, demos)
-        print(f"{robot:14s} step {step:<6g} region spans {_span(survey):5.1f} steps; "
-              f"95 % of starts need {_moves95(survey)} moves", flush=True)
+        survey = survey_at_step(task.replace({"learner.step": step}), model, low, high, demos)
+        print(f"{robot:14s} step {step:<6g} region spans {region_span(survey):5.1f} steps; "
+              f"95 % of starts need {moves95(survey)} moves", flush=True)

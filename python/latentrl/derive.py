@@ -98,13 +98,13 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
     survey = None
     if "learner.step" not in given:
         budget = config["episode"]["max_steps"] if "episode.max_steps" in given else _default("episode.max_steps")
-        found = learner_step(lambda s: _survey(task.replace({"learner.step": s}), model, low, high, demos), budget)
+        found = learner_step(lambda s: survey_at_step(task.replace({"learner.step": s}), model, low, high, demos), budget)
         if found is not None:
             step, survey, rule = found
             out.append(Derived("learner.step", step, rule))
     if "episode.max_steps" not in given:
-        survey = survey or _survey(task.replace({"learner.step": step}), model, low, high, demos)
-        needed = _moves95(survey)
+        survey = survey or survey_at_step(task.replace({"learner.step": step}), model, low, high, demos)
+        needed = moves95(survey)
         if needed is not None:
             default = _default("episode.max_steps")
             value = int(min(default, max(MIN_STEPS, SLACK * needed)))
@@ -126,7 +126,7 @@ def learner_step(survey_at: Callable[[float], dict[str, Any]], budget: int) -> t
     fitting = None
     for candidate in STEPS:
         found = survey_at(candidate)
-        span, moves = _span(found), _moves95(found)
+        span, moves = region_span(found), moves95(found)
         fits = moves is not None and FIT * moves <= budget
         if fits:
             fitting = (candidate, found, span, moves)
@@ -176,19 +176,21 @@ def _default(key: str) -> Any:
     return next(e["default"] for e in schema() if e["key"] == key)
 
 
-def _survey(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.float64],
-            demos: NDArray[np.float64]) -> dict[str, Any]:
+def survey_at_step(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.float64],
+                   demos: NDArray[np.float64]) -> dict[str, Any]:
+    """`latentrl check`'s survey of the latent box [`low`, `high`] at `task`'s `learner.step`:
+    which points decode to admissible postures, reach the target, and in how many moves."""
     return _native.latent_survey(task._native, decoder=model.decoder_, latent_low=low, latent_high=high, demos=demos)
 
 
-def _moves95(survey: dict[str, Any]) -> int | None:
+def moves95(survey: dict[str, Any]) -> int | None:
     """The moves to the target that 95 % of the admissible starts with a path need (None: no path)."""
     moves = np.asarray(survey["moves"])
     moves = moves[moves >= 0]
     return int(np.percentile(moves, 95)) if len(moves) else None
 
 
-def _span(survey: dict[str, Any]) -> float:
+def region_span(survey: dict[str, Any]) -> float:
     """Learner steps the target region spans across: the side of a square (cube…) of its points."""
     reached = int(np.asarray(survey["reached"]).sum())
     return float(reached ** (1 / len(survey["shape"])) * survey["stride"]) if reached else 0.0
