@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from latentrl.cli import saved_run
-from latentrl.experiments.runner import load_arrays
+from latentrl.experiments.results import RunFolder
 from latentrl.replay import episode_path, recorded, render_frames
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -26,7 +26,7 @@ def fps(run: Path, width: int, frames: int) -> dict[str, float]:
     link poses and the latent path of the stored rows, then the frames (reading the run's saved
     GPLVM included)."""
     name, preset = saved_run(run)
-    arrays = load_arrays(run)
+    arrays = RunFolder(run).arrays()
     rows, _ = episode_path(arrays, 0, None, 0, preset.episodes)
     rows = rows[np.linspace(0, len(rows) - 1, frames).round().astype(int)]
     start = time.perf_counter()

@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from latentrl.experiments.exp1 import Exp1Preset
-from latentrl.experiments.registry import run_experiment
+from latentrl.experiments import run_experiment
 
 
 def main() -> None:

@@ -12,14 +12,14 @@ from pathlib import Path
 
 import numpy as np
 
-from latentrl.experiments.runner import load_arrays
-from latentrl.experiments.sweep_summary import episodes_to_threshold
+from latentrl.experiments.results import RunFolder
+from latentrl.experiments.sweep import episodes_to_threshold
 from latentrl.task import end_reasons
 
 WINDOW = 500
 out = Path(sys.argv[1])
 meta = json.loads((out / "results.json").read_text())
-a = load_arrays(out)
+a = RunFolder(out).arrays()
 returns, ends, reached, passed = a["latent"], a["latent_end"], a["latent_reached"], a["latent_passed"]
 done = ends[:, -1] >= 0
 returns, ends, reached, passed = returns[done], ends[done], reached[done], passed[done]

@@ -8,7 +8,7 @@ import argparse
 from pathlib import Path
 
 from latentrl.experiments.exp3 import Exp3Preset
-from latentrl.experiments.registry import run_experiment
+from latentrl.experiments import run_experiment
 
 
 def main() -> None:

@@ -109,7 +109,7 @@ def test_help_and_a_bad_flag_load_no_experiment(argv):
             "    try: main(sys.argv[1:])\n"
             "    except SystemExit: pass\n"
             "print(sorted(m for m in sys.modules if m.startswith(('latentrl.experiments.exp', "
-            "'latentrl.experiments.table1', 'latentrl.experiments.registry', 'tqdm'))))")
+            "'latentrl.experiments.table1', 'latentrl.experiments.runner', 'tqdm'))))")
     done = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, timeout=300, check=True)
     assert done.stdout.strip() == "[]"
 
@@ -324,14 +324,13 @@ def test_fit_reports_bad_demonstration_files(tmp_path):
 
 def test_plot_redraws_the_finished_trials_of_a_partial_run(tmp_path):
     from latentrl.experiments.exp1 import Exp1Preset
-    from latentrl.experiments.registry import run_experiment
+    from latentrl.experiments import run_experiment
     from latentrl.experiments.presets import with_overrides
-    from latentrl.experiments.results import write_npz
-    from latentrl.experiments.runner import finished_trials, load_arrays
+    from latentrl.experiments.results import RunFolder, finished_trials, write_npz
 
     run_experiment("exp1", with_overrides(Exp1Preset.quick(), {"trials": 2, "episodes": 5, "plant.max_steps": 20}),
              tmp_path / "run", progress=False)
-    arrays = load_arrays(tmp_path / "run")
+    arrays = RunFolder(tmp_path / "run").arrays()
     arrays["full_end"][1] = -1  # as an interrupted run leaves it: full trial 2 not run
     arrays["full"][1] = np.nan
     write_npz(tmp_path / "run" / "returns.npz", arrays)

@@ -7,9 +7,9 @@ import json
 import numpy as np
 import pytest
 
-from latentrl.experiments import exp1, exp1_figures
+from latentrl.experiments import exp1
 from latentrl.experiments.exp1 import Exp1Preset
-from latentrl.experiments.registry import run_experiment
+from latentrl.experiments import run_experiment
 from latentrl.experiments.presets import with_overrides
 from latentrl.experiments.runner import run_rl
 from learning import assert_separated, control
@@ -97,7 +97,7 @@ def test_interrupted_run_resumes_to_the_uninterrupted_result(tmp_path):
         return built
 
     with pytest.raises(KeyboardInterrupt):
-        run_rl(TINY, tmp_path / "part", setup=interrupting_setup, figures=exp1_figures.figures, chunk=1, progress=False)
+        run_rl(TINY, tmp_path / "part", setup=interrupting_setup, figures=exp1.figures, chunk=1, progress=False)
     with np.load(tmp_path / "part" / "returns.npz") as npz:
         assert (npz["full_end"][1] == -1).all() and (npz["full_end"][0] >= 0).all()
     run_experiment("exp1", TINY, tmp_path / "part", progress=False)

@@ -143,7 +143,7 @@ def test_pca_falls_holding_the_top_pose_and_the_gplvm_stands():
 
 def test_fig7a_frames_agree_with_the_table(tmp_path):
     pytest.importorskip("matplotlib")
-    from latentrl.experiments.fallcheck_figures import fallcheck_frames
+    from latentrl.experiments.fallcheck import fallcheck_frames
 
     seen = fallcheck_frames(tmp_path, ("pose", 6))
     for ext in ("png", "pdf"):
@@ -158,7 +158,7 @@ def test_fig7a_frames_agree_with_the_table(tmp_path):
 
 @pytest.mark.parametrize("segment", [("pose", 7), ("line", 3), ("curve", 1)])
 def test_fig7a_rejects_unknown_segments(tmp_path, segment):
-    from latentrl.experiments.fallcheck_figures import fallcheck_frames
+    from latentrl.experiments.fallcheck import fallcheck_frames
 
     with pytest.raises(ValueError, match="segment must name one of"):
         fallcheck_frames(tmp_path, segment=segment)

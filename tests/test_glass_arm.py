@@ -198,11 +198,12 @@ def test_a_task_with_move_corrections_trains_draws_and_saves(tmp_path):
 def test_the_failures_figure_shows_the_last_episodes_a_stopped_trial_ran(monkeypatch, tmp_path):
     """A trial the stopping rule ended after 500 of 1000 episodes: the figure's "last fifth" is
     of the 500 it ran (100, every one failed here), not of the budget's NaN tail."""
-    from latentrl.experiments import training_run
+    from latentrl import plots
+    from latentrl.experiments import training
 
     titles = []
-    monkeypatch.setattr(training_run, "latent_value_panel", lambda *args, **kwargs: None)
-    monkeypatch.setattr(training_run, "save_figure", lambda fig, out, name: titles.append(fig.axes[0].get_title()))
+    monkeypatch.setattr(plots, "latent_value_panel", lambda *args, **kwargs: None)
+    monkeypatch.setattr(plots, "save_figure", lambda fig, out, name: titles.append(fig.axes[0].get_title()))
     budget, ran = 1000, 500
     ends = np.full((1, budget), -1, dtype=np.int8)
     ends[0, :ran] = 0  # timeouts
@@ -210,7 +211,7 @@ def test_the_failures_figure_shows_the_last_episodes_a_stopped_trial_ran(monkeyp
     means[0, :ran] = 0.0
     arrays = {"latent": np.full((1, budget), np.nan), "latent_end": ends, "latent_reached": np.zeros((1, budget), bool),
               "latent_mean_state": means, "latent_weights": np.zeros((1, 4))}
-    training_run.failures(arrays, "stopped", np.zeros(2), np.ones(2), None, {}, tmp_path)
+    training.failures(arrays, "stopped", np.zeros(2), np.ones(2), None, {}, tmp_path)
     assert titles == ["stopped: where the last 100 episodes of trial 0 failed (100)"]
 
 

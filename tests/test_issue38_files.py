@@ -20,7 +20,7 @@ from latentrl._base import read_npz
 from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, open_regular, read_bounded, read_text
 from latentrl._native import InvalidInputError, Sim
 from latentrl.experiments.results import read_json
-from latentrl.experiments.sweep_types import load_sweep
+from latentrl.experiments.sweep import load_sweep
 from latentrl.task import Task
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"

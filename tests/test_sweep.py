@@ -16,9 +16,9 @@ from child import CHILD, wait_for
 
 from latentrl.cli import main
 from latentrl.experiments.exp1 import Exp1Preset
-from latentrl.experiments.registry import run_experiment
+from latentrl.experiments import run_experiment
 from latentrl.experiments.sweep import Sweep, SweepError, load_sweep, run_sweep
-from latentrl.experiments.sweep_summary import episodes_to_threshold
+from latentrl.experiments.sweep import episodes_to_threshold
 
 # A local Ray instance on 127.0.0.1 only (Ray's single-machine mode), set before ray is imported.
 os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
@@ -285,7 +285,7 @@ def test_the_documented_example_runs(tmp_path, backend):
 
 
 def test_the_package_never_imports_ray_itself():
-    code = ("import sys, latentrl.cli, latentrl.experiments.ray_backend, latentrl.experiments.sweep_summary; "
+    code = ("import sys, latentrl.cli, latentrl.experiments.ray_backend, latentrl.experiments.sweep; "
             "latentrl.cli.build_parser(); sys.exit('ray' in sys.modules)")
     assert subprocess.run([sys.executable, "-c", code], timeout=120).returncode == 0
 

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 from latentrl.experiments import exp3
 from latentrl.experiments.presets import with_overrides
-from latentrl.experiments.registry import run_experiment
+from latentrl.experiments import run_experiment
 
 demos, out, which = sys.argv[1], sys.argv[2], sys.argv[3]
 if demos != "shipped":

@@ -38,14 +38,13 @@ def saved_run(out_dir: Path, *, train: bool = False) -> tuple[str, Any]:
     """(experiment name, preset) of the RL run in `out_dir`, from its results.json — with `train`,
     also ("train", its TrainRun) for a `latentrl train` directory; ValueError if the directory
     holds none, or the preset does not fit this version."""
-    from latentrl.experiments.registry import experiments
-    from latentrl.experiments.results import read_results
+    from latentrl.experiments import experiments
+    from latentrl.experiments.results import RunFolder
 
-    meta_path = out_dir / "results.json"
-    if not meta_path.is_file():
+    folder = RunFolder(out_dir)
+    if not folder.results_path.is_file():
         raise ValueError(f"{out_dir}: no results.json there, so no run of an RL experiment")
-    meta = read_results(meta_path)
-    fields = dict(meta.get("preset") or {})
+    fields = folder.preset()
     preset_name = fields.pop("name", None)
     known = [(name, exp.preset) for name, exp in experiments().items() if exp.rl]
     if train:
@@ -60,7 +59,7 @@ def saved_run(out_dir: Path, *, train: bool = False) -> tuple[str, Any]:
     if unknown:
         raise ValueError(f"{out_dir}: its preset has fields this version does not know: {unknown}")
     preset = preset_cls(**fields)
-    recorded = meta.get("setup", {}).get("task")
+    recorded = folder.recorded_task()
     if name == "train" or recorded is None:
         return name, preset
     return name, _as_recorded(out_dir, name, preset, recorded)
@@ -71,7 +70,7 @@ def _as_recorded(out_dir: Path, name: str, preset: Any, recorded: dict[str, Any]
     version's task does not give (a shipped task file changed since the run): its figures, replays and resume
     use the task its trials ran with. A key added since the run takes its default, the
     behaviour before it. A key no override can set is a ValueError."""
-    from latentrl.experiments.registry import experiments, task_schema
+    from latentrl.experiments import experiments, task_schema
 
     rl = experiments()[name].rl
     assert rl is not None
@@ -183,7 +182,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _run_flags(run: argparse.ArgumentParser) -> None:
     """`run`'s subcommands, one per experiment (each adding its flags when used)."""
-    from latentrl.experiments.registry import experiments
+    from latentrl.experiments import experiments
 
     run_sub = run.add_subparsers(dest="experiment", required=True)
     for name, exp in experiments().items():
@@ -194,7 +193,7 @@ def _run_flags(run: argparse.ArgumentParser) -> None:
 def _experiment_flags(name: str, cmd: argparse.ArgumentParser) -> None:
     """`run NAME`'s flags: its preset's fields and, for an RL experiment, its task's keys (the
     defaults shown: its task file's)."""
-    from latentrl.experiments.registry import experiments, task_schema
+    from latentrl.experiments import experiments, task_schema
 
     exp = experiments()[name]
     cmd.add_argument("--out", type=Path, help=f"results directory (default: results/{name})")
@@ -341,7 +340,7 @@ def _flag(key: str) -> str:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from latentrl.experiments.registry import experiments
+    from latentrl.experiments import experiments
 
     exp = experiments()[args.experiment]
     overrides = _overrides(args, exp.preset)
@@ -378,8 +377,9 @@ def _interruptible(work: Callable[[], object], out: Path, resume_command: str) -
 
 
 def _train(args: argparse.Namespace) -> int:
-    from latentrl.experiments.training import TrainRun
-    from latentrl.experiments.training_run import run_training  # matplotlib: the [plot] extra
+    import matplotlib.pyplot  # noqa: F401  (the figures' [plot] extra: missing, exit 1 before any work)
+
+    from latentrl.experiments.training import TrainRun, run_training
 
     base = TrainRun.quick() if args.quick else TrainRun()
     overrides = _overrides(args, TrainRun)
@@ -531,16 +531,16 @@ def _fit(args: argparse.Namespace) -> int:
 
 
 def _plot(args: argparse.Namespace) -> int:
-    from latentrl.experiments.registry import experiments
-    from latentrl.experiments.runner import finished_trials, load_arrays
+    from latentrl.experiments import experiments
+    from latentrl.experiments.results import RunFolder
 
     name, preset = saved_run(args.results, train=True)
-    arrays, done = finished_trials(load_arrays(args.results))
+    arrays, done = RunFolder(args.results).finished()
     if not done:
         raise ValueError(f"{args.results}: no finished trial to plot")
     out = args.out or args.results
     if name == "train":
-        from latentrl.experiments.training_run import figures
+        from latentrl.experiments.training import figures
 
         figures(preset, arrays, args.results, out)
     else:

@@ -299,7 +299,7 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     """Renders one recorded episode of the run in `run_dir` (`experiment` "exp1", "exp2", "exp3"
     or "train", its saved `preset`) to the video `out` and/or the Rerun recording `rerun`;
     returns what was rendered. Every argument is checked before drawing."""
-    from latentrl.experiments.runner import load_arrays
+    from latentrl.experiments.results import RunFolder
 
     if experiment not in REPLAYABLE:
         raise ValueError(f"{run_dir}: a run of {experiment}; replay draws runs of {', '.join(REPLAYABLE[:-1])} "
@@ -307,8 +307,9 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     if (episode is None) == (test is None):
         raise ValueError("give one of --episode E (a recorded training episode) or --test T (a frozen test episode)")
     check_request(out, rerun, fps, width, max_frames, view)
-    arrays = load_arrays(run_dir)  # its errors name the file
-    check_replay_arrays(run_dir / "returns.npz", arrays)
+    folder = RunFolder(run_dir)
+    arrays = folder.arrays()  # its errors name the file
+    check_replay_arrays(folder.arrays_path, arrays)
     rows, what = episode_path(arrays, trial, episode, test, preset.episodes)
     weights = arrays.get("latent_weights")
     if weights is None:

@@ -4,11 +4,15 @@ A full-space learner (4-D hand positions, 12 actions, 20⁴ RBFs) against a late
 (GPLVM d = 2 on demonstrated constraint-satisfying hand pairs, 4 actions, 20² RBFs). The plant
 is the kinematic toy of `sim::bimanual` (keys `plant.*`), the learner `learner.*`: both
 declared, with their defaults and rules, in Rust (`latentrl run exp1 --help` lists them).
+
+Figures (the `[plot]` extra, matplotlib imported when they are drawn): Fig. 4a (learning curves),
+4b and 4c (hand paths during and after learning).
 """
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -18,8 +22,9 @@ import numpy as np
 
 from latentrl import _native
 from latentrl.datasets import bimanual_pairs
-from latentrl.experiments.latent_runs import Fitted, gplvm_info, recorded_episodes, run_fit
+from latentrl.experiments.latent_runs import Fitted, recorded_episodes, run_fit
 from latentrl.experiments.presets import LatentRun, check_ints
+from latentrl.experiments.results import gplvm_info
 from latentrl.experiments.runner import RunTrials, Setup
 
 
@@ -97,3 +102,33 @@ def setup(preset: Exp1Preset, run: Path | None = None) -> Setup:
         "learner": learner,
     }
     return Setup(learners=learners, info=info, model=model)
+
+
+# --- figures ----------------------------------------------------------------------------------
+
+
+def figures(preset: Exp1Preset, arrays: Mapping[str, np.ndarray], run: Path, out: Path) -> None:
+    """Fig. 4a (learning curves), 4b (hand paths during learning), 4c (after learning) of a run
+    into `out` (they need nothing of the run's directory `run` beyond `arrays`)."""
+    import matplotlib.pyplot as plt
+
+
+    from latentrl.plots import hand_paths, learning_curves, save_figure
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    learning_curves(ax, {name: arrays[name] for name in ("latent", "full") if name in arrays})
+    ax.set_title("Exp 1: bimanual reaching, mean ± s.d. over trials")
+    save_figure(fig, out, "fig4a")
+    record = recorded_episodes(preset.episodes)
+    plant, _ = configs(preset)
+    disc = ((*plant["obstacle_centre"], plant["obstacle_radius"]),)
+    target = np.asarray(plant["target"])
+    for name, episodes in (("fig4b", record[:3]), ("fig4c", record[-3:])):
+        fig, axes = plt.subplots(1, 2, figsize=(9, 4.5), sharex=True, sharey=True)
+        for ax, learner in zip(axes, ("latent", "full")):
+            paths = arrays.get(f"{learner}_paths")
+            if paths is None:
+                continue
+            hand_paths(ax, paths[0, [record.index(e) for e in episodes]], target=target, discs=disc)
+            ax.set_title(f"{learner}: episodes {', '.join(str(e + 1) for e in episodes)} (trial 1)")
+        save_figure(fig, out, name)

@@ -1,6 +1,6 @@
 """What the latent-space experiments' setups share: the GPLVM fit and its latent box (a run's
-own, read back from its directory), which episodes keep their paths, the fitted GPLVM's
-metadata for the results, and the native trial runner bound to a task, a GPLVM and its latent
+own, read back from its directory: `RunFolder`), which episodes keep their paths, and the
+native trial runner bound to a task, a GPLVM and its latent
 box."""
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl.experiments.presets import latent_box
-from latentrl.experiments.results import as_saved, read_results
-from latentrl.experiments.runner import MODEL_FILE, RunTrials, Setup
+from latentrl.experiments.results import RunFolder, gplvm_info
+from latentrl.experiments.runner import RunTrials, Setup
 from latentrl.gplvm import GPLVM
 from latentrl.task import Task
 
@@ -44,25 +44,18 @@ class Fitted:
         return cls(model.X_train_, model, low, high)
 
 
-def run_fit(run: Path | str | None, margin: float, refit: Callable[[], Fitted]) -> Fitted:
-    """The fit of the run in directory `run`: the GPLVM its trials learnt in, read from
-    `MODEL_FILE`, so its figures, replays and resumes use that latent space on any machine (a
-    refit on another CPU or BLAS can land elsewhere: docs/robustness.md). `refit()` without a
-    run, or before the run's first save; for a run saved before models were kept, `refit()`
-    checked against the fit results.json records."""
-    meta_path = None if run is None else Path(run) / "results.json"
-    if meta_path is None or not meta_path.exists():
+def run_fit(run: RunFolder | Path | str | None, margin: float, refit: Callable[[], Fitted]) -> Fitted:
+    """The fit of the run in directory `run`: the GPLVM its trials learnt in, read from its
+    `MODEL_FILE` (`RunFolder.model`), so its figures, replays and resumes use that latent space
+    on any machine (a refit on another CPU or BLAS can land elsewhere: docs/robustness.md).
+    `refit()` without a run, or before the run's first save; for a run saved before models were
+    kept, `refit()` checked against the fit results.json records (`RunFolder.check_fit`)."""
+    folder = run if isinstance(run, RunFolder) or run is None else RunFolder(run)
+    if folder is None or not folder.holds_run():
         return refit()
-    model_path = meta_path.parent / MODEL_FILE
-    kept = model_path.exists()
-    fitted = Fitted.of_model(GPLVM.load(model_path), margin) if kept else refit()
-    saved, now = read_results(meta_path).get("setup", {}).get("gplvm"), as_saved(gplvm_info(fitted.model))
-    if saved is not None and saved != now:
-        source = f"{model_path} (nll {now['nll']})" if kept else (
-            f"the GPLVM refitted on this machine (nll {now['nll']}; the run has no {MODEL_FILE}, and another CPU "
-            "or BLAS can fit another latent space)")
-        raise ValueError(f"{source} is not the one the saved trials used (nll {saved.get('nll')}, "
-                         f"{meta_path}); refusing to mix them: restore the run's files, or start a new run with --out")
+    saved = folder.model()
+    fitted = Fitted.of_model(saved, margin) if saved is not None else refit()
+    folder.check_fit(fitted.model, kept=saved is not None)
     return fitted
 
 
@@ -77,18 +70,6 @@ def recorded_episodes(episodes: int) -> list[int]:
 def recorded_tests(test_episodes: int) -> list[int]:
     """Frozen test episodes whose paths are kept (Fig. 6c, 7d, 8): the first ten."""
     return list(range(min(10, test_episodes)))
-
-
-def gplvm_info(model: GPLVM) -> dict[str, Any]:
-    """The fitted GPLVM's objective, hyper-parameters and convergence, for results.json."""
-    return {
-        "nll": model.nll_,
-        "theta": model.theta_,
-        "converged": model.converged_,
-        "n_iter": model.n_iter_,
-        "encoder": model.fitted_encoder_,
-        "encoder_theta": model.encoder_theta_,
-    }
 
 
 def task_learner(

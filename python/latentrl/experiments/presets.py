@@ -104,6 +104,22 @@ def check_floats(preset: Any, names: tuple[str, ...], *, positive: bool) -> None
             raise ValueError(f"{name} must be a finite number {bound}, got {value!r}")
 
 
+_KIND_NAMES = {bool: "true or false", int: "an integer", float: "a number", str: "a string"}
+
+
+def check_type(where: str, value: Any, kind: type, minimum: int | None = None) -> Any:
+    """`value` (named `where` in the error) as a `kind` (an int is a float too, a bool is neither), or a ValueError."""
+    ok = isinstance(value, kind) and (kind is bool or not isinstance(value, bool))
+    if kind is float and isinstance(value, int) and not isinstance(value, bool):
+        value, ok = float(value), True
+    if not ok:
+        raise ValueError(f"{where}: expected {_KIND_NAMES[kind]}, got {value!r}")
+    if minimum is not None and value < minimum:
+        raise ValueError(f"{where}: must be >= {minimum}, got {value!r}")
+    return value
+
+
+
 class Overrides(dict[str, Any]):
     """Task keys by path → values: a dict that hashes by its items, so that presets holding one
     stay hashable (caches, sweep cells)."""

@@ -26,9 +26,10 @@ from typing import Any, ClassVar
 import numpy as np
 
 from latentrl.experiments.results import worker_threads
-from latentrl.experiments.runner import PER_EPISODE, PER_TRIAL, Setup, load_arrays, run_rl
-from latentrl.experiments.registry import rl_experiments
-from latentrl.experiments.sweep_types import Job, check_type
+from latentrl.experiments import rl_experiments
+from latentrl.experiments.presets import check_type
+from latentrl.experiments.results import PER_EPISODE, PER_TRIAL, RunFolder
+from latentrl.experiments.runner import Job, Setup, run_rl
 
 
 def setup_fingerprint(built: Setup) -> str:
@@ -143,13 +144,13 @@ class RayBackend:
                         for future in done:
                             job, error = futures[future], future.exception()
                             if error is not None:
-                                failures[job.cell.id] = error
+                                failures[job.id] = error
                                 continue
                             kind = rl_experiments()[job.experiment]
                             try:  # here, not in the cells' threads: pyplot is not thread-safe
-                                kind.figures(job.cell.preset, load_arrays(job.out), job.out, job.out)
+                                kind.figures(job.preset, RunFolder(job.out).arrays(), job.out, job.out)
                             except Exception as err:  # noqa: BLE001 - reported with the cell
-                                failures[job.cell.id] = err
+                                failures[job.id] = err
                                 continue
                             finished(job)
                 except BaseException:
@@ -187,7 +188,7 @@ class RayBackend:
                 raise _Stopped
             fingerprint = setup_fingerprint(built)
             refs = {
-                remote.remote(job.experiment, job.cell.preset, fingerprint, name, first, n): (name, first, n)
+                remote.remote(job.experiment, job.preset, fingerprint, name, first, n): (name, first, n)
                 for name, first, n in chunks
             }
             errors: list[str] = []
@@ -213,7 +214,7 @@ class RayBackend:
                 more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
                 raise RuntimeError(f"{errors[0]}{more}")
 
-        run_rl(job.cell.preset, job.out, setup=kind.setup, figures=_no_figures, progress=False,
+        run_rl(job.preset, job.out, setup=kind.setup, figures=_no_figures, progress=False,
                chunk=self.batch, execute=execute)
 
 

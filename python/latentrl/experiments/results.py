@@ -1,5 +1,7 @@
 """Results files of a run (docs/method.md §Results layout): metadata JSON and per-episode NPZ,
-written atomically."""
+written atomically; what returns.npz and gplvm.npz hold; and `RunFolder`, a run's directory read
+back: its preset, recorded task, inputs and fit, its arrays and its model, with the checks that
+a run resumed, replayed, plotted or rolled out is the run it says it is (issue #38)."""
 
 from __future__ import annotations
 
@@ -11,12 +13,16 @@ import resource
 import subprocess
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from latentrl._base import atomic_write
+from latentrl._base import atomic_write, read_npz
 from latentrl._files import MAX_JSON_BYTES, read_text
+from latentrl.task import changed_since, ran_with
+
+if TYPE_CHECKING:  # the GPLVM (and SciPy) load with the first run read back, not with `--help`
+    from latentrl.gplvm import GPLVM
 
 RESULTS_FORMAT = 1
 """Version of the results layout; bumped when a file changes meaning."""
@@ -81,6 +87,272 @@ def read_results(path: Path) -> dict[str, Any]:
     if bad:
         raise ValueError(f"{path}: setup.inputs[{bad[0]!r}] must be a SHA-256 string")
     return meta
+
+
+# --- what returns.npz and gplvm.npz hold -----------------------------------------------------
+
+PER_EPISODE = {
+    "returns": "",
+    "ends": "_end",
+    "steps": "_steps",
+    "reached": "_reached",
+    "passed": "_passed",
+}
+"""Per-episode arrays of the native call, each (trials, episodes), and the suffix of their
+key in returns.npz after the learner's name (docs/method.md §Results layout: `latent`, `latent_end`,
+…)."""
+
+PER_TRIAL = {
+    "test_returns": "_test",
+    "test_ends": "_test_end",
+    "test_steps": "_test_steps",
+    "test_reached": "_test_reached",
+    "test_passed": "_test_passed",
+    "trajectories": "_paths",
+    "test_trajectories": "_test_paths",
+    "test_start_hands": "_test_start_hands",
+    "mean_states": "_mean_state",
+    "weights": "_weights",
+}
+"""Further per-trial arrays of the native call (frozen test episodes (trials, K), recorded
+paths, the effectors' (x, y, z) at the start of every test episode (trials, K, 3E), the
+learner's mean state over every training episode (trials, episodes, d), final weights) and
+their suffix in returns.npz; stored when the call returns them with a non-empty per-trial
+part."""
+
+
+def array_key(learner: str, what: str) -> str:
+    """Key in returns.npz of a learner's array `what` (see PER_EPISODE and PER_TRIAL)."""
+    return learner + {**PER_EPISODE, **PER_TRIAL}[what]
+
+
+PRESET_KEY = "preset_json"
+"""Key in returns.npz of the preset the arrays were computed with (JSON): `--resume` refuses a
+results.json whose preset was edited since."""
+
+MODEL_FILE = "gplvm.npz"
+"""A run's GPLVM in its results directory (`GPLVM.save`): what its figures, replays and resumes
+decode with, since a refit on another CPU or BLAS can give another latent space."""
+
+
+def gplvm_info(model: GPLVM) -> dict[str, Any]:
+    """The fitted GPLVM's objective, hyper-parameters and convergence, for results.json."""
+    return {
+        "nll": model.nll_,
+        "theta": model.theta_,
+        "converged": model.converged_,
+        "n_iter": model.n_iter_,
+        "encoder": model.fitted_encoder_,
+        "encoder_theta": model.encoder_theta_,
+    }
+
+
+# --- a run folder read back ------------------------------------------------------------------
+
+
+class RunFolder:
+    """The results directory of a run (docs/method.md §Results layout) read back: results.json
+    (the preset, the recorded task, input digests and fit), returns.npz and gplvm.npz, each read
+    once when first asked for (a folder written since is read by a new `RunFolder`). It owns
+    the checks that a run continued (`previous`, `check_continued`), replayed, plotted or rolled
+    out (`check_inputs`, `check_fit`) is the run it says it is; each error names the file or the
+    input that differs."""
+
+    def __init__(self, path: Path | str) -> None:
+        self.path = Path(path)
+        self._results: dict[str, Any] | None = None
+        self._arrays: dict[str, np.ndarray] | None = None
+        self._model: tuple[GPLVM, dict[str, np.ndarray]] | None = None
+
+    @property
+    def results_path(self) -> Path:
+        """results.json: the preset, the setup's facts, the per-trial summaries."""
+        return self.path / "results.json"
+
+    @property
+    def arrays_path(self) -> Path:
+        """returns.npz: the per-episode and per-trial arrays (`PER_EPISODE`, `PER_TRIAL`)."""
+        return self.path / "returns.npz"
+
+    @property
+    def model_path(self) -> Path:
+        """gplvm.npz: the GPLVM the trials learnt in (`MODEL_FILE`)."""
+        return self.path / MODEL_FILE
+
+    def holds_run(self) -> bool:
+        """Whether a run saved its results here (results.json exists)."""
+        return self.results_path.exists()
+
+    def results(self) -> dict[str, Any]:
+        """results.json (`read_results`: its errors name the file and the field)."""
+        if self._results is None:
+            self._results = read_results(self.results_path)
+        return self._results
+
+    def preset(self) -> dict[str, Any]:
+        """The preset results.json records (its fields and `name`), {} if none."""
+        return dict(self.results().get("preset") or {})
+
+    def recorded_task(self) -> dict[str, Any] | None:
+        """The effective task the trials ran with (`Task.to_dict`), None where none was recorded."""
+        task: dict[str, Any] | None = self.results().get("setup", {}).get("task")
+        return task
+
+    def recorded_inputs(self) -> dict[str, str]:
+        """The SHA-256 of each input the run was made from, by name ("task file", "urdf", "demos",
+        "model"); {} for a run that recorded none."""
+        return dict(self.results().get("setup", {}).get("inputs") or {})
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Every array of returns.npz: a ValueError naming the file if it is not readable or an
+        array (but the preset's JSON) holds anything but numbers."""
+        if self._arrays is None:
+            path = self.arrays_path
+            try:
+                arrays = read_npz(path)
+            except ValueError as err:
+                raise ValueError(f"{path}: {err}") from None
+            for key, value in arrays.items():
+                if key != PRESET_KEY and value.dtype.kind not in "biuf":
+                    raise ValueError(f"{path}: {key} holds {value.dtype} values, expected numbers")
+            self._arrays = arrays
+        return self._arrays
+
+    def finished(self) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+        """`finished_trials` of the arrays."""
+        return finished_trials(self.arrays())
+
+    def model(self) -> GPLVM | None:
+        """The GPLVM saved in gplvm.npz, None if the run has none (saved before models were kept)."""
+        saved = self._saved_model()
+        return None if saved is None else saved[0]
+
+    def model_arrays(self) -> dict[str, np.ndarray] | None:
+        """gplvm.npz's arrays as read (what the run's "model" digest covers), None without one."""
+        saved = self._saved_model()
+        return None if saved is None else saved[1]
+
+    def _saved_model(self) -> tuple[GPLVM, dict[str, np.ndarray]] | None:
+        """gplvm.npz read once: the GPLVM and the arrays it was made from."""
+        if self._model is None:
+            if not self.model_path.exists():
+                return None
+            from latentrl.gplvm import GPLVM
+
+            try:
+                arrays = read_npz(self.model_path)
+            except ValueError as err:
+                raise ValueError(f"{self.model_path}: {err}") from err
+            self._model = GPLVM._from_arrays(arrays, str(self.model_path)), arrays
+        return self._model
+
+    def previous(self, plan: dict[str, Any]) -> tuple[dict[str, np.ndarray], dict[str, Any] | None]:
+        """Arrays and metadata of an earlier run of the preset `plan` (`describe`) in this folder,
+        ({}, None) if there is none; a ValueError if the folder holds a run of another preset, or
+        one whose results.json was edited after its trials ran. Temporary files a killed write
+        left are removed first."""
+        for path in (self.results_path, self.arrays_path):
+            remove_stale_temporaries(path)
+        if not self.results_path.exists():
+            return {}, None
+        meta = self.results()
+        recorded = self.recorded_task()
+        ran = ran_with(recorded) if recorded is not None else {}
+        if edited_fields(meta.get("preset") or {}, as_saved(plan), ran):
+            raise ValueError(
+                f"{self.path} holds a run of a different preset; choose another --out "
+                "or delete it (only a run of the same preset is continued)"
+            )
+        if not self.arrays_path.exists():
+            return {}, None
+        arrays = self.arrays()
+        self._check_saved_run(plan, arrays, ran)
+        return arrays, meta
+
+    def _check_saved_run(self, plan: dict[str, Any], arrays: Mapping[str, np.ndarray], ran: Mapping[str, Any]) -> None:
+        """The arrays of a run being continued were computed with `plan`; a ValueError naming the
+        edited fields otherwise (mixing would be silently wrong)."""
+        if PRESET_KEY in arrays:
+            saved, now = json.loads(str(arrays[PRESET_KEY])), as_saved(plan)
+            edited = edited_fields(saved, now, ran)
+            if edited:
+                changes = ", ".join(f"{k}: {saved.get(k)!r} in returns.npz, {now.get(k)!r} in results.json" for k in edited)
+                raise ValueError(f"{self.path}/results.json was edited after its trials ran ({changes}); resume refuses "
+                                 "to mix the two: restore the file, or start a new run with --out")
+
+    def check_continued(self, meta: Mapping[str, Any], learners: Mapping[str, Any] | list[str], info: Mapping[str, Any],
+                        arrays: Mapping[str, np.ndarray]) -> None:
+        """A continued run's trials ran with the task the setup (its `learners` and recorded
+        `info`) builds and its per-episode arrays have the preset's shapes (its model fit is
+        checked where the setup reads it back: `check_fit`) and with the inputs it recorded
+        (`check_inputs`: first, since a changed input can change settings derived from it)."""
+        check_inputs(meta.get("setup", {}).get("inputs") or {}, info.get("inputs") or {}, self.path)
+        recorded = meta.get("setup", {}).get("task")
+        keys = sorted(changed_since(recorded, as_saved(info.get("task")) or {})) if recorded is not None else []
+        if keys:
+            raise ValueError(f"{self.path}: its trials ran with another task ({', '.join(keys)} differ); resume "
+                             "refuses to mix the two: start a new run with --out")
+        want = (meta["preset"]["trials"], meta["preset"]["episodes"])
+        for name in learners:
+            for what in PER_EPISODE:
+                key = array_key(name, what)
+                if key not in arrays:
+                    raise ValueError(f"{self.path}/returns.npz: {key} is missing; restore the file, or start a new "
+                                     "run with --out")
+                if arrays[key].shape != want:
+                    raise ValueError(f"{self.path}/returns.npz: {key} has shape {arrays[key].shape}, the preset asks "
+                                     f"for {want} (trials, episodes); it belongs to another run")
+
+    def check_inputs(self, now: Mapping[str, str]) -> None:
+        """`check_inputs` of the digests the run recorded against `now`'s."""
+        check_inputs(self.recorded_inputs(), now, self.path)
+
+    def check_fit(self, model: GPLVM, *, kept: bool) -> None:
+        """`model` (the saved gplvm.npz's if `kept`, else a refit) is the fit results.json records
+        (`gplvm_info`); a ValueError naming the source otherwise."""
+        saved, now = self.results().get("setup", {}).get("gplvm"), as_saved(gplvm_info(model))
+        if saved is not None and saved != now:
+            source = f"{self.model_path} (nll {now['nll']})" if kept else (
+                f"the GPLVM refitted on this machine (nll {now['nll']}; the run has no {MODEL_FILE}, and another CPU "
+                "or BLAS can fit another latent space)")
+            raise ValueError(f"{source} is not the one the saved trials used (nll {saved.get('nll')}, "
+                             f"{self.results_path}); refusing to mix them: restore the run's files, or start a new "
+                             "run with --out")
+
+
+def edited_fields(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any]) -> list[str]:
+    """The preset fields that differ between `saved` and `now`. A task override that only
+    restores what the trials ran with (`ran`: `task.ran_with` of the recorded task, empty if none
+    was recorded) is not an edit: `cli.saved_run` adds those when a shipped task changed since."""
+    edited = [k for k in set(saved) | set(now) if k != "task" and saved.get(k) != now.get(k)]
+    before, after = saved.get("task") or {}, now.get("task") or {}
+    restored = {k for k in set(after) - set(before) if k in ran and ran[k] == after[k]}
+    if {k for k in set(before) | set(after) if before.get(k) != after.get(k)} - restored:
+        edited.append("task")
+    return sorted(edited)
+
+
+def check_inputs(recorded: Mapping[str, str], now: Mapping[str, str], out: Path) -> None:
+    """ValueError naming the first input (task file, URDF, demos, model) whose SHA-256 the run
+    recorded and that now differs: a run is continued, replayed, rolled out or plotted only with
+    what it was made from."""
+    for name, digest in recorded.items():
+        if name in now and now[name] != digest:
+            raise ValueError(f"{out}: its {name} changed since the run (sha256 {digest[:12]}… ≠ {now[name][:12]}…); "
+                             "the run is refused rather than mixed with it: restore it, or start a new run with --out")
+
+
+def finished_trials(arrays: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
+    """The rows of finished trials only, learner by learner (a partial run's unrun trials are
+    NaN or −1), and how many each learner has. Learners with none are left out."""
+    learners = [key for key in arrays if array_key(key, "ends") in arrays]
+    done = {name: arrays[array_key(name, "ends")][:, 0] >= 0 for name in learners}
+    kept: dict[str, np.ndarray] = {}
+    for key, value in arrays.items():
+        owner = max((n for n in learners if key == n or key.startswith(n + "_")), key=len, default=None)
+        if owner is not None and done[owner].any():
+            kept[key] = value[done[owner]]
+    return kept, {name: int(mask.sum()) for name, mask in done.items() if mask.any()}
 
 
 def _to_plain(value: Any) -> Any:

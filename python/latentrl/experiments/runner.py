@@ -14,20 +14,23 @@ import time
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
-from latentrl._base import read_npz
 from latentrl.run_lock import run_lock
-from latentrl.task import changed_since, end_reasons, ran_with
+from latentrl.task import end_reasons
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
+    MODEL_FILE,
+    PER_EPISODE,
+    PER_TRIAL,
+    PRESET_KEY,
+    RunFolder,
+    array_key,
     as_saved,
     environment,
     peak_rss_mib,
-    read_results,
-    remove_stale_temporaries,
     worker_threads,
     write_json,
     write_npz,
@@ -36,42 +39,22 @@ from latentrl.experiments.results import (
 END_CODES = dict(enumerate(end_reasons()))
 """How an episode ended, as stored in `<learner>_end` (−1: not run): the native names."""
 
-PER_EPISODE = {
-    "returns": "",
-    "ends": "_end",
-    "steps": "_steps",
-    "reached": "_reached",
-    "passed": "_passed",
-}
-"""Per-episode arrays of the native call, each (trials, episodes), and the suffix of their
-key in returns.npz after the learner's name (docs/method.md §Results layout: `latent`, `latent_end`,
-…)."""
-
-PER_TRIAL = {
-    "test_returns": "_test",
-    "test_ends": "_test_end",
-    "test_steps": "_test_steps",
-    "test_reached": "_test_reached",
-    "test_passed": "_test_passed",
-    "trajectories": "_paths",
-    "test_trajectories": "_test_paths",
-    "test_start_hands": "_test_start_hands",
-    "mean_states": "_mean_state",
-    "weights": "_weights",
-}
-"""Further per-trial arrays of the native call (frozen test episodes (trials, K), recorded
-paths, the effectors' (x, y, z) at the start of every test episode (trials, K, 3E), the
-learner's mean state over every training episode (trials, episodes, d), final weights) and
-their suffix in returns.npz; stored when the call returns them with a non-empty per-trial
-part."""
-
-
-def array_key(learner: str, what: str) -> str:
-    """Key in returns.npz of a learner's array `what` (see PER_EPISODE and PER_TRIAL)."""
-    return learner + {**PER_EPISODE, **PER_TRIAL}[what]
-
 #: A learner: runs trials `first .. first + n` and returns the native call's dict.
 RunTrials = Callable[..., dict[str, Any]]
+
+
+class Job(NamedTuple):
+    """A run to make elsewhere than `run_rl`'s caller (a sweep's cell on a backend): an RL
+    experiment's preset into its results directory."""
+
+    experiment: str
+    """The experiment's name (`latentrl.experiments.rl_experiments`)."""
+    id: str
+    """What the run is called in messages (a sweep's cell id)."""
+    preset: Any
+    """The preset to run."""
+    out: Path
+    """Its results directory."""
 
 
 class Preset(Protocol):
@@ -96,11 +79,6 @@ class Setup:
     info: dict[str, Any] = field(default_factory=dict)
     model: Any = None
     """The fitted model the learners work in (a GPLVM), saved beside the results as `MODEL_FILE`."""
-
-
-MODEL_FILE = "gplvm.npz"
-"""A run's GPLVM in its results directory (`GPLVM.save`): what its figures, replays and resumes
-decode with, since a refit on another CPU or BLAS can give another latent space."""
 
 
 #: Runs chunks of trials `(learner, first, count)` of a setup and yields each chunk with its
@@ -157,13 +135,14 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
             chunk: int | None, execute: Execute) -> dict[str, Any]:
     from latentrl.progress import progress_bar  # tqdm: loaded by a run, not by `run NAME --help`
 
-    meta_path, arrays_path = out / "results.json", out / "returns.npz"
+    folder = RunFolder(out)
+    meta_path, arrays_path = folder.results_path, folder.arrays_path
     plan = describe(preset)
-    arrays, meta = _previous(meta_path, arrays_path, plan)
+    arrays, meta = folder.previous(plan)
     started = time.perf_counter()
     built = setup(preset, out)
     if meta is not None:
-        _check_continued(meta, built, arrays, out)
+        folder.check_continued(meta, list(built.learners), built.info, arrays)
     arrays[PRESET_KEY] = np.array(json.dumps(as_saved(plan), sort_keys=True))
     chunk = chunk or worker_threads()
     if built.model is not None and (meta is None or not (out / MODEL_FILE).exists()):
@@ -265,117 +244,6 @@ def _chunks(todo: list[tuple[str, int]], size: int) -> list[tuple[str, int, int]
         else:
             out.append((name, t, 1))
     return out
-
-
-def _previous(
-    meta_path: Path, arrays_path: Path, plan: dict[str, Any]
-) -> tuple[dict[str, np.ndarray], dict[str, Any] | None]:
-    """Arrays and metadata of an earlier run of the same preset in this directory, if any."""
-    for path in (meta_path, arrays_path):
-        remove_stale_temporaries(path)
-    if not meta_path.exists():
-        return {}, None
-    meta = read_results(meta_path)
-    recorded = meta.get("setup", {}).get("task")
-    ran = ran_with(recorded) if recorded is not None else {}
-    if _edited(meta.get("preset") or {}, as_saved(plan), ran):
-        raise ValueError(
-            f"{meta_path.parent} holds a run of a different preset; choose another --out "
-            "or delete it (only a run of the same preset is continued)"
-        )
-    if not arrays_path.exists():
-        return {}, None
-    arrays = load_arrays(arrays_path.parent)
-    _check_saved_run(meta_path.parent, plan, arrays, ran)
-    return arrays, meta
-
-
-PRESET_KEY = "preset_json"
-"""Key in returns.npz of the preset the arrays were computed with (JSON): `--resume` refuses a
-results.json whose preset was edited since."""
-
-
-def _edited(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any]) -> list[str]:
-    """The preset fields that differ between `saved` and `now`. A task override that only
-    restores what the trials ran with (`ran`: `task.ran_with` of the recorded task, empty if none
-    was recorded) is not an edit: `cli.saved_run` adds those when a shipped task changed since."""
-    edited = [k for k in set(saved) | set(now) if k != "task" and saved.get(k) != now.get(k)]
-    before, after = saved.get("task") or {}, now.get("task") or {}
-    restored = {k for k in set(after) - set(before) if k in ran and ran[k] == after[k]}
-    if {k for k in set(before) | set(after) if before.get(k) != after.get(k)} - restored:
-        edited.append("task")
-    return sorted(edited)
-
-
-def _check_saved_run(out: Path, plan: dict[str, Any], arrays: Mapping[str, np.ndarray], ran: Mapping[str, Any]) -> None:
-    """The arrays of a run being continued were computed with `plan`; a ValueError naming the
-    edited fields otherwise (mixing would be silently wrong)."""
-    if PRESET_KEY in arrays:
-        saved, now = json.loads(str(arrays[PRESET_KEY])), as_saved(plan)
-        edited = _edited(saved, now, ran)
-        if edited:
-            changes = ", ".join(f"{k}: {saved.get(k)!r} in returns.npz, {now.get(k)!r} in results.json" for k in edited)
-            raise ValueError(f"{out}/results.json was edited after its trials ran ({changes}); resume refuses to mix "
-                             "the two: restore the file, or start a new run with --out")
-
-
-def _check_continued(meta: Mapping[str, Any], built: Setup, arrays: Mapping[str, np.ndarray], out: Path) -> None:
-    """A continued run's trials ran with the task the setup builds and its per-episode arrays
-    have the preset's shapes (its model fit is checked where the setup reads it back:
-    `latent_runs.run_fit`) and with the inputs it recorded (`check_inputs`: first, since a
-    changed input can change settings derived from it)."""
-    check_inputs(meta.get("setup", {}).get("inputs") or {}, built.info.get("inputs") or {}, out)
-    recorded = meta.get("setup", {}).get("task")
-    keys = sorted(changed_since(recorded, as_saved(built.info.get("task")) or {})) if recorded is not None else []
-    if keys:
-        raise ValueError(f"{out}: its trials ran with another task ({', '.join(keys)} differ); resume refuses to "
-                         "mix the two: start a new run with --out")
-    want = (meta["preset"]["trials"], meta["preset"]["episodes"])
-    for name in built.learners:
-        for what in PER_EPISODE:
-            key = array_key(name, what)
-            if key not in arrays:
-                raise ValueError(f"{out}/returns.npz: {key} is missing; restore the file, or start a new run with --out")
-            if arrays[key].shape != want:
-                raise ValueError(f"{out}/returns.npz: {key} has shape {arrays[key].shape}, the preset asks for "
-                                 f"{want} (trials, episodes); it belongs to another run")
-
-
-def check_inputs(recorded: Mapping[str, str], now: Mapping[str, str], out: Path) -> None:
-    """ValueError naming the first input (task file, URDF, demos, model) whose SHA-256 the run
-    recorded and that now differs: a run is continued, replayed, rolled out or plotted only with
-    what it was made from."""
-    for name, digest in recorded.items():
-        if name in now and now[name] != digest:
-            raise ValueError(f"{out}: its {name} changed since the run (sha256 {digest[:12]}… ≠ {now[name][:12]}…); "
-                             "the run is refused rather than mixed with it: restore it, or start a new run with --out")
-
-
-def load_arrays(out_dir: Path | str) -> dict[str, np.ndarray]:
-    """Every array of a results directory's returns.npz: a ValueError naming the file if it is not
-    readable or an array (but the preset's JSON) holds anything but numbers."""
-    path = Path(out_dir) / "returns.npz"
-    try:
-        arrays = read_npz(path)
-    except ValueError as err:
-        raise ValueError(f"{path}: {err}") from None
-    for key, value in arrays.items():
-        if key != PRESET_KEY and value.dtype.kind not in "biuf":
-            raise ValueError(f"{path}: {key} holds {value.dtype} values, expected numbers")
-    return arrays
-
-
-def finished_trials(arrays: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
-    """The rows of finished trials only, learner by learner (a partial run's unrun trials are
-    NaN or −1), and how many each learner has. Learners with none are left out."""
-    learners = [key for key in arrays if array_key(key, "ends") in arrays]
-    done = {name: arrays[array_key(name, "ends")][:, 0] >= 0 for name in learners}
-    kept: dict[str, np.ndarray] = {}
-    for key, value in arrays.items():
-        owner = max((n for n in learners if key == n or key.startswith(n + "_")), key=len, default=None)
-        if owner is not None and done[owner].any():
-            kept[key] = value[done[owner]]
-    return kept, {name: int(mask.sum()) for name, mask in done.items() if mask.any()}
 
 
 def _save(meta_path: Path, arrays_path: Path, meta: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:

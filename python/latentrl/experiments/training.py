@@ -1,5 +1,7 @@
 """`latentrl train`: a latent policy on any task from a demo file (or a saved GPLVM), run with
-the one runner (docs/method.md §Results layout, resumable) and saved as `DIR/policy.npz`."""
+the one runner (docs/method.md §Results layout, resumable) and saved as `DIR/policy.npz`, with
+its figures: the return curve and, for a 2-D latent space, the value function before and after
+learning and where late episodes failed (the `[plot]` extra, imported when they are drawn)."""
 
 from __future__ import annotations
 
@@ -14,14 +16,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from latentrl._base import read_npz
 from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded
 from latentrl.demos import load_demos
 from latentrl.recorded import recording_kind
 from latentrl.recorded.options import DemoOptions
 from latentrl.experiments.presets import latent_box
 from latentrl.gplvm import GPLVM
-from latentrl.task import Task
+from latentrl.task import Task, end_reasons
 from latentrl.train import LatentPolicy, TrainPreset
 
 if TYPE_CHECKING:  # the fit, the runner and the derivations load with the first run, not with `train --help`
@@ -83,20 +84,18 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
     margin)."""
     from latentrl.derive import applied, derive
     from latentrl.experiments.latent_runs import Fitted, run_fit
-    from latentrl.experiments.results import read_results
-    from latentrl.experiments.runner import MODEL_FILE, check_inputs
+    from latentrl.experiments.results import RunFolder
 
     overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
     options = DemoOptions(**{f.name: getattr(run, f.name) for f in dataclasses.fields(DemoOptions)})
     task, demos, model = _load(run.task_file, overrides, run.demos, options, run.model, run.seed, run.gplvm_max_iter,
                                run.encoder)
     if out is not None:
-        model = run_fit(out, run.latent_margin, lambda: Fitted.of_model(model, run.latent_margin)).model
-        meta = Path(out) / "results.json"
-        if meta.is_file():  # a run read back (resume, replay, rollout, plot): made from these inputs?
-            recorded = read_results(meta).get("setup", {}).get("inputs") or {}
-            saved = read_npz(Path(out) / MODEL_FILE) if (Path(out) / MODEL_FILE).is_file() else model._arrays()
-            check_inputs(recorded, input_digests(run.task_file, task, demos, saved), Path(out))
+        folder = RunFolder(out)  # gplvm.npz and results.json read once, for the fit and the digests
+        model = run_fit(folder, run.latent_margin, lambda: Fitted.of_model(model, run.latent_margin)).model
+        if folder.results_path.is_file():  # a run read back (resume, replay, rollout, plot): made from these inputs?
+            saved = folder.model_arrays()
+            folder.check_inputs(input_digests(run.task_file, task, demos, model._arrays() if saved is None else saved))
     fit = hashlib.sha256(np.ascontiguousarray(model.Z_).tobytes() + np.ascontiguousarray(demos).tobytes())
     key = (task.digest(), fit.hexdigest(), task.given, run.latent_margin)
     if key not in _DERIVED:
@@ -126,7 +125,7 @@ def input_digests(task_file: str, task: Task, demos: np.ndarray, model: Mapping[
     """SHA-256 of what a run is made from: the task file's and the URDF's bytes, the demo
     postures as the learner gets them (joint order, float64) and the GPLVM's arrays as saved
     (`model`: a run's gplvm.npz as read, so a parameter a later version adds does not change
-    it); a resume compares them (`runner.check_inputs`)."""
+    it); a resume compares them (`RunFolder.check_inputs`)."""
     def sha(data: bytes) -> str:
         return hashlib.sha256(data).hexdigest()
 
@@ -140,10 +139,10 @@ def input_digests(task_file: str, task: Task, demos: np.ndarray, model: Mapping[
 
 def save_policy(run: TrainRun, out: Path) -> LatentPolicy:
     """`out/policy.npz` from the finished trials of the run in `out`."""
-    from latentrl.experiments.runner import finished_trials, load_arrays
+    from latentrl.experiments.results import RunFolder
 
     task, demos, model = fitted(run, out)
-    arrays, done = finished_trials(load_arrays(out))
+    arrays, done = RunFolder(out).finished()
     if not done:
         raise ValueError(f"{out}: no finished trial, so no policy")
     low, high = latent_box(model.Z_, run.latent_margin)
@@ -156,3 +155,72 @@ def save_policy(run: TrainRun, out: Path) -> LatentPolicy:
                           weights=arrays["latent_weights"], preset=run, record=record)
     policy.save(out / "policy.npz")
     return policy
+
+
+# --- the run and its figures ------------------------------------------------------------------
+
+
+def run_training(run: TrainRun, out_dir: Path | str, *, progress: bool = True) -> dict[str, Any]:
+    """Runs (or continues) the training into `out_dir` with the one runner, draws its figures and
+    writes its policy (`policy.npz`); without matplotlib (the `[plot]` extra) it fails
+    (ModuleNotFoundError) before any work."""
+    import matplotlib.pyplot  # noqa: F401  (the figures' extra, checked before the trials run)
+
+    from latentrl.experiments.runner import run_rl
+
+    meta = run_rl(run, out_dir, setup=setup, figures=figures, progress=progress)
+    save_policy(run, Path(out_dir))
+    return meta
+
+
+def figures(run: TrainRun, arrays: Mapping[str, np.ndarray], run_dir: Path, out: Path) -> None:
+    """`returns.png` (mean ± s.d. over trials, running mean) and, with d = 2, `value_before.png`,
+    `value_after.png` (trial 1), PNG + PDF."""
+    import matplotlib.pyplot as plt
+
+    from latentrl.plots import latent_value_panel, learning_curves, save_figure
+
+    task, _, model = fitted(run, run_dir)
+    learner = task.to_dict()["learner"]
+    fig, ax = plt.subplots(figsize=(6, 4))
+    learning_curves(ax, {"latent": arrays["latent"]}, window=max(1, min(100, run.episodes // 5)))
+    ax.set_title(f"{task.name}: return per episode, mean ± s.d. over trials")
+    save_figure(fig, out, "returns")
+    if model.n_components_ != 2 or "latent_weights" not in arrays:
+        return
+    low, high = latent_box(model.Z_, run.latent_margin)
+    for name, weights in (("value_before", None), ("value_after", np.asarray(arrays["latent_weights"])[0])):
+        fig, ax = plt.subplots(figsize=(6, 5))
+        latent_value_panel(ax, weights, low, high, model, learner=learner)
+        ax.set_title(f"{task.name}: value function {name.split('_')[1]} learning")
+        save_figure(fig, out, name)
+    if "latent_mean_state" in arrays:
+        failures(arrays, task.name, low, high, model, learner, out)
+
+
+def failures(arrays: Mapping[str, np.ndarray], name: str, low: np.ndarray, high: np.ndarray, model: Any,
+             learner: Mapping[str, Any], out: Path) -> None:
+    """`failures.png`: trial 0's V after learning with, for each episode of the last fifth of the
+    episodes it ran that never came within the reach radius, its mean latent state, coloured by how it
+    ended (where in the latent space episodes fail)."""
+    import matplotlib.pyplot as plt
+
+    from latentrl.plots import latent_value_panel, save_figure
+
+    trial = 0
+    ran = int((np.asarray(arrays["latent_end"])[trial] >= 0).sum())  # a stopped trial ran fewer than its budget
+    fifth = max(1, ran // 5)
+    last = slice(ran - fifth, ran)
+    means = np.asarray(arrays["latent_mean_state"])[trial, last]
+    ends = np.asarray(arrays["latent_end"])[trial, last]
+    failed = ~np.asarray(arrays["latent_reached"], dtype=bool)[trial, last] & np.isfinite(means).all(axis=1)
+    fig, ax = plt.subplots(figsize=(6, 5))
+    latent_value_panel(ax, np.asarray(arrays["latent_weights"])[trial], low, high, model, learner=learner)
+    for code, reason in enumerate(end_reasons()):
+        mine = failed & (ends == code)
+        if mine.any():
+            ax.plot(means[mine, 0], means[mine, 1], "x", ms=5, color=f"C{code}", label=f"{reason} ({mine.sum()})")
+    if failed.any():
+        ax.legend(fontsize=7, loc="upper right", title="failed, by ending", title_fontsize=7)
+    ax.set_title(f"{name}: where the last {fifth} episodes of trial {trial} failed ({failed.sum()})")
+    save_figure(fig, out, "failures")
