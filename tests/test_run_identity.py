@@ -1,14 +1,21 @@
-"""A run is what it says it is (issue #38): `train --resume` refuses a run whose URDF was edited,
-whose demos were reordered or whose saved GPLVM's latent points were permuted, naming what
-changed (each was continued and merged before, with exit code 0)."""
+"""A run is what it says it is (issue #38): `train --resume` refuses a run whose task file or URDF
+was edited, whose demos were reordered or whose saved GPLVM's latent points were permuted, naming
+what changed (each was continued and merged before, with exit code 0); a `train` run killed
+(SIGKILL) or interrupted (SIGINT) mid-way resumes to the bits of an uninterrupted run; a run
+folder moved elsewhere still replays and plots."""
 
+import json
+import os
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from child import CHILD, wait_for
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
 
@@ -53,7 +60,13 @@ def permute_model(folder):
     np.savez(path, **arrays)
 
 
-@pytest.mark.parametrize(("edit", "name"), [(edit_urdf, "urdf"), (reorder_demos, "demos"), (permute_model, "model")])
+def edit_task(folder):
+    text = (folder / "glass_arm.toml").read_text()
+    (folder / "glass_arm.toml").write_text(text + "\n# an edit\n")
+
+
+@pytest.mark.parametrize(("edit", "name"), [(edit_task, "task file"), (edit_urdf, "urdf"), (reorder_demos, "demos"),
+                                            (permute_model, "model")])
 def test_an_edited_input_is_refused_by_name(run, edit, name):
     folder, resume = run
     before = (folder / "out" / "returns.npz").read_bytes()
@@ -62,11 +75,6 @@ def test_an_edited_input_is_refused_by_name(run, edit, name):
     assert result.returncode == 1 and f"its {name} changed since the run (sha256 " in result.stderr, result.stderr
     assert "Traceback" not in result.stderr
     assert (folder / "out" / "returns.npz").read_bytes() == before
-
-
-def edit_task(folder):
-    text = (folder / "glass_arm.toml").read_text()
-    (folder / "glass_arm.toml").write_text(text + "\n# an edit\n")
 
 
 @pytest.mark.parametrize(("edit", "name"), [(reorder_demos, "demos"), (edit_task, "task file")])
@@ -98,3 +106,92 @@ def test_a_run_started_with_relative_paths_is_read_back_from_anywhere(tmp_path):
     result = latentrl("rollout", str(tmp_path / "out"), "--out", "rolled", "--episodes", "1", "--no-progress",
                       cwd=elsewhere)
     assert result.returncode == 0, result.stderr
+
+
+# --- a train run stopped mid-way, and moved ---------------------------------------------------
+
+TWO_TRIALS = ["--quick", "--trials", "2", "--episodes", "4", "--test-episodes", "1", "--episode.max-steps", "10",
+              "--no-progress"]
+"""Two trials, so that with one rayon thread the runner saves after the first and the child can be
+stopped between the two."""
+
+
+def train_args(inputs, out):
+    return ["train", str(inputs / "glass_arm.toml"), "--demos", str(inputs / "demos.csv"), "--out", str(out),
+            *TWO_TRIALS]
+
+
+def saved_arrays(out):
+    """What a resumed run must reproduce bit for bit: returns.npz's arrays, the per-trial summaries
+    of results.json, the policy's arrays and the saved GPLVM."""
+    found = {}
+    for name in ("returns.npz", "policy.npz", "gplvm.npz"):
+        with np.load(out / name) as npz:
+            found.update({f"{name}:{key}": npz[key] for key in npz.files})
+    found["results.json:trials"] = json.loads((out / "results.json").read_text())["trials"]
+    return found
+
+
+@pytest.fixture(scope="module")
+def uninterrupted_train(tmp_path_factory):
+    """The inputs (copied once: the preset records their absolute paths) and the arrays of an
+    uninterrupted two-trial run on one thread."""
+    inputs = tmp_path_factory.mktemp("inputs")
+    for name in ("glass_arm.toml", "glass_arm.urdf", "demos.csv"):
+        shutil.copy(EXAMPLE / name, inputs / name)
+    out = inputs / "uninterrupted"
+    result = subprocess.run([sys.executable, "-m", "latentrl", *train_args(inputs, out)], capture_output=True,
+                            text=True, timeout=300, env={**os.environ, "RAYON_NUM_THREADS": "1"})
+    assert result.returncode == 0, result.stderr
+    return inputs, saved_arrays(out)
+
+
+@pytest.mark.parametrize("how", [signal.SIGINT, signal.SIGKILL], ids=["ctrl-c", "kill-9"])
+def test_a_train_run_stopped_mid_way_resumes_to_the_uninterrupted_bits(uninterrupted_train, tmp_path, how):
+    """Issue #38: `latentrl train` stopped after its first trial was saved (the child holds there:
+    tests/child.py), by Ctrl-C (exit 130, the resume command named) or kill -9, then continued
+    with `--resume`, ends with the arrays, summaries, policy and model of the uninterrupted run."""
+    inputs, expected = uninterrupted_train
+    out, held = tmp_path / "run", tmp_path / "held"
+    env = {**os.environ, "RAYON_NUM_THREADS": "1", "LATENTRL_TEST_HOLD_AFTER_SAVE": str(held)}
+    proc = subprocess.Popen([sys.executable, "-c", CHILD, *train_args(inputs, out)], env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    wait_for(held, proc)
+    proc.send_signal(how)
+    _, err = proc.communicate(timeout=60)
+    if how == signal.SIGINT:
+        assert proc.returncode == 130, err
+        assert "interrupted; finished trials are in" in err and "--resume" in err, err
+        assert "Traceback" not in err
+    else:
+        assert proc.returncode == -signal.SIGKILL
+    with np.load(out / "returns.npz") as npz:  # whatever was saved is whole (atomic writes)
+        assert (npz["latent_end"][:, 0] >= 0).sum() == 1, "expected the run stopped after its first trial"
+    assert not (out / "policy.npz").exists()
+    resumed = latentrl(*train_args(inputs, out), "--resume")
+    assert resumed.returncode == 0, resumed.stderr
+    found = saved_arrays(out)
+    assert found.keys() == expected.keys()
+    for key, value in expected.items():
+        if isinstance(value, np.ndarray):
+            np.testing.assert_array_equal(found[key], value, err_msg=key)
+        else:
+            assert found[key] == value, key
+    assert not list(out.glob(".*.tmp")), "a killed write's temporary file was left behind"
+
+
+def test_a_moved_train_run_folder_replays_and_plots(run, tmp_path):
+    """Issue #38: a run folder moved (renamed into another directory) is read back where it now
+    is: replayed and re-plotted, its inputs still checked (they did not change)."""
+    folder, _ = run
+    moved = tmp_path / "elsewhere" / "moved"
+    moved.parent.mkdir()
+    (folder / "out").rename(moved)
+    video = tmp_path / "moved.gif"
+    result = latentrl("replay", str(moved), "--test", "0", "--out", str(video))
+    assert result.returncode == 0 and video.is_file(), result.stderr
+    result = latentrl("plot", str(moved), "--out", str(tmp_path / "figures"))
+    assert result.returncode == 0 and (tmp_path / "figures" / "returns.png").is_file(), result.stderr
+    reorder_demos(folder)  # and an input edited since is still refused by name from the new place
+    result = latentrl("replay", str(moved), "--test", "0", "--out", str(tmp_path / "x.gif"))
+    assert result.returncode == 1 and "its demos changed since the run (sha256 " in result.stderr, result.stderr
