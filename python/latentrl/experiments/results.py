@@ -11,7 +11,7 @@ import os
 import platform
 import resource
 import subprocess
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -280,10 +280,10 @@ class RunFolder:
                 raise ValueError(f"{self.path}/results.json was edited after its trials ran ({changes}); resume refuses "
                                  "to mix the two: restore the file, or start a new run with --out")
 
-    def check_continued(self, meta: Mapping[str, Any], learners: Mapping[str, Any] | list[str], info: Mapping[str, Any],
+    def check_continued(self, meta: Mapping[str, Any], learners: Iterable[str], info: Mapping[str, Any],
                         arrays: Mapping[str, np.ndarray]) -> None:
-        """A continued run's trials ran with the task the setup (its `learners` and recorded
-        `info`) builds and its per-episode arrays have the preset's shapes (its model fit is
+        """A continued run's trials ran with the task the setup (its `learners` by name and its
+        recorded `info`) builds and its per-episode arrays have the preset's shapes (its model fit is
         checked where the setup reads it back: `check_fit`) and with the inputs it recorded
         (`check_inputs`: first, since a changed input can change settings derived from it)."""
         check_inputs(meta.get("setup", {}).get("inputs") or {}, info.get("inputs") or {}, self.path)

@@ -22,7 +22,6 @@ from latentrl.run_lock import run_lock
 from latentrl.task import end_reasons
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
-    MODEL_FILE,
     PER_EPISODE,
     PER_TRIAL,
     PRESET_KEY,
@@ -78,7 +77,7 @@ class Setup:
     learners: dict[str, RunTrials]
     info: dict[str, Any] = field(default_factory=dict)
     model: Any = None
-    """The fitted model the learners work in (a GPLVM), saved beside the results as `MODEL_FILE`."""
+    """The fitted model the learners work in (a GPLVM), saved beside the results as `results.MODEL_FILE`."""
 
 
 #: Runs chunks of trials `(learner, first, count)` of a setup and yields each chunk with its
@@ -142,12 +141,12 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
     started = time.perf_counter()
     built = setup(preset, out)
     if meta is not None:
-        folder.check_continued(meta, list(built.learners), built.info, arrays)
+        folder.check_continued(meta, built.learners, built.info, arrays)
     arrays[PRESET_KEY] = np.array(json.dumps(as_saved(plan), sort_keys=True))
     chunk = chunk or worker_threads()
-    if built.model is not None and (meta is None or not (out / MODEL_FILE).exists()):
+    if built.model is not None and (meta is None or not folder.model_path.exists()):
         out.mkdir(parents=True, exist_ok=True)
-        built.model.save(out / MODEL_FILE)
+        built.model.save(folder.model_path)
     if meta is None:
         meta = {"preset": plan, "environment": environment(), "setup": built.info, "wall_time_s": 0.0}
     for name in built.learners:
