@@ -6,7 +6,6 @@ mean return of the first and last 500 episodes (mean ± s.d. over trials, range)
 rates of the last 500, the first episode whose running reach rate (window 500) is ≥ 90 %,
 endings over all and the last 500 episodes, RL steps, wall time and peak memory.
 """
-import json
 import sys
 from pathlib import Path
 
@@ -18,8 +17,8 @@ from latentrl.task import end_reasons
 
 WINDOW = 500
 out = Path(sys.argv[1])
-meta = json.loads((out / "results.json").read_text())
-a = RunFolder(out).arrays()
+folder = RunFolder(out)
+meta, a = folder.results(), folder.arrays()
 returns, ends, reached, passed = a["latent"], a["latent_end"], a["latent_reached"], a["latent_passed"]
 done = ends[:, -1] >= 0
 returns, ends, reached, passed = returns[done], ends[done], reached[done], passed[done]

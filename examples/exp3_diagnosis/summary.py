@@ -7,22 +7,23 @@ test succeeds when it reached h* and ended by the step limit), test endings, obs
 in the last 500 training episodes, return and reach rate early and late, and the style count of
 the successful training episodes (`exp3.episode_styles`).
 """
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from latentrl.experiments import exp3
 from latentrl.cli import saved_run
+from latentrl.experiments import exp3
+from latentrl.experiments.results import RunFolder
 from latentrl.task import end_reasons
 
 out = Path(sys.argv[1])
-meta = json.loads((out / "results.json").read_text())
+folder = RunFolder(out)
+meta = folder.results()
 _, preset = saved_run(out)
-with np.load(out / "returns.npz") as npz:
-    done = npz["latent_test_end"][:, -1] >= 0  # finished trials only (a run may be unfinished)
-    a = {k: npz[k][done] for k in npz.files if npz[k].ndim and npz[k].shape[0] == len(done)}
+arrays = folder.arrays()
+done = arrays["latent_test_end"][:, -1] >= 0  # finished trials only (a run may be unfinished)
+a = {k: v[done] for k, v in arrays.items() if v.ndim and v.shape[0] == len(done)}
 ends, reached = a["latent_test_end"], a["latent_test_reached"]
 ok = (ends == 0) & reached
 floor = a["latent_test_start_hands"][..., [2, 5]].max(-1) <= exp3.FLOOR_LEVEL
