@@ -150,9 +150,8 @@ def test_the_step_keeps_the_path_within_half_an_episode():
 
     def surveys(spans: dict[float, float], moves: dict[float, int]):
         def at(step: float) -> dict:
-            reached = round(spans[step] ** 2)  # derive.region_span: the side of a square of reached points, stride 1
-            return {"reached": np.ones(reached, bool), "shape": (10, 10), "stride": 1,
-                    "moves": np.full(20, moves[step])}
+            reached = round(spans[step] ** 2)  # derive.region_span: the side of a square of the region's points
+            return {"region_points": reached, "shape": (10, 10), "stride": 1, "moves": np.full(20, moves[step])}
         return at
 
     spans = {1.0: 0.0, 0.5: 1.0, 0.25: 2.2, 0.125: 4.5, 0.0625: 8.5}
@@ -184,3 +183,31 @@ def test_servo_gains_are_derived_where_the_task_is_silent():
     gains = {key: d.value for key, d in derived.items()}
     assert set(gains) == {"servo.kp", "servo.kd"} and "they hold" in derived["servo.kp"].rule
     assert servo_error(task.replace(gains), demos) <= 0.01
+
+
+def test_a_coarsened_grid_still_measures_the_target_region_at_the_learner_step(glass):
+    """Issue #37: a grid kept within its point budget runs at a stride of several learner steps,
+    and a target region smaller than a cell fell between its points — the zoo's iiwa-style arm
+    was told "will not learn, closest 51 mm" while 4 of its demos hold the tray within 33–46 mm
+    of the target. Looked into again at the learner's step, the region and the closest point
+    match the full grid's."""
+    from latentrl import _native
+    from latentrl.experiments.presets import latent_box
+
+    task, demos, model = glass
+    task = task.replace({"learner.step": 0.25, "target.reach_radius": 0.01})
+    low, high = latent_box(model.Z_, 0.1)
+
+    def survey(max_points: int) -> dict:
+        return _native.latent_survey(task._native, decoder=model.decoder_, latent_low=low, latent_high=high,
+                                     demos=demos, max_points=max_points)
+
+    full, coarse = survey(100_000), survey(600)
+    assert full["stride"] == 1 and coarse["stride"] >= 3
+    assert full["region_points"] == int(full["reached"].sum()) > 0
+    # The coarse points alone come no nearer than 10.6 mm (outside the 1 cm radius); looked into
+    # at the learner's step, the cells hold the region's points and the closest, 2.7 mm.
+    assert coarse["distance"][coarse["codes"] == 0].min() > 3 * full["closest"]["distance"]
+    assert 0.8 * full["region_points"] <= coarse["region_points"] <= full["region_points"]
+    assert coarse["closest"]["distance"] == pytest.approx(full["closest"]["distance"], abs=1e-3)
+    assert np.isfinite(coarse["closest"]["point"]).all() and len(coarse["closest"]["effectors"]) == 3

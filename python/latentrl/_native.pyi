@@ -436,7 +436,9 @@ def latent_survey(
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
     """The task's latent space at rest on a grid at its learner step: per point the rule broken,
-    reward, distance, reached, effectors, and the fewest learner moves to the target region."""
+    reward, distance, reached, effectors, and the fewest learner moves to the target region;
+    `region_points` (the region's points at the learner's step) and `closest` (the admissible
+    point closest to the target: point, effectors, distance, reward; absent if none)."""
 
 def learner_values(
     learner: Mapping[str, object],

@@ -192,7 +192,7 @@ def survey_findings(task: Task, survey: dict[str, Any]) -> list[Finding]:
     """The latent box, the target and the paths to it, from `_native.latent_survey`."""
     config = task.to_dict()
     radius = config["target"]["reach_radius"]
-    codes, distance, moves = survey["codes"], survey["distance"], survey["moves"]
+    codes, moves = survey["codes"], survey["moves"]
     admissible = codes == 0
     shape, stride = tuple(survey["shape"]), int(survey["stride"])
     share = float(admissible.mean())
@@ -205,12 +205,12 @@ def survey_findings(task: Task, survey: dict[str, Any]) -> list[Finding]:
                   f"{share:.0%} of a {grid} decode to admissible postures at rest",
                   None if share >= ADMISSIBLE_SHARE else "a smaller --latent-margin, or demos that span the task",
                   {"shape": list(shape), "stride": stride, "admissible": share})
-    closest = int(np.flatnonzero(admissible)[np.argmin(distance[admissible])])
-    best = float(distance[closest])
-    where = np.round(survey["points"][closest], 3).tolist()
-    effectors = np.round(survey["effectors"][closest], 3).reshape(-1, 3).tolist()
-    reached = survey["reached"]
-    if not reached.any():
+    closest = survey["closest"]
+    best = float(closest["distance"])
+    where = np.round(closest["point"], 3).tolist()
+    effectors = np.round(closest["effectors"], 3).reshape(-1, 3).tolist()
+    n_reached = int(survey["region_points"])
+    if not n_reached:
         target = Finding(
             "target", "will not learn",
             f"no admissible latent point is within target.reach_radius = {radius:g} m of the target: the closest "
@@ -218,12 +218,11 @@ def survey_findings(task: Task, survey: dict[str, Any]) -> list[Finding]:
             f"target.position = {effectors} (reachable), or target.reach_radius = {np.ceil(best * 1000) / 1000:g}, "
             "or demos that reach the target", {"closest_m": best, "closest_z": where})
         return [box, target]
-    n_reached = int(reached.sum())
-    isolated = n_reached <= 2 and stride == 1
+    isolated = n_reached <= 2
     target = Finding(
         "target", "warning" if isolated else "ok",
-        f"{n_reached} admissible grid points are within {radius:g} m of the target (closest {best * 1000:.1f} mm, "
-        f"best reward {float(survey['reward'][admissible].max()):.3f})"
+        f"{n_reached} admissible points a learner step apart are within {radius:g} m of the target (closest "
+        f"{best * 1000:.1f} mm, best reward {max(float(survey['reward'][admissible].max()), closest['reward']):.3f})"
         + ("; the region is about one learner step wide, so a step can jump over it" if isolated else ""),
         f"learner.step = {config['learner']['step'] / 2:g} (half) lands more often inside it" if isolated else None,
         {"reached_points": n_reached, "closest_m": best})

@@ -191,6 +191,7 @@ def moves95(survey: dict[str, Any]) -> int | None:
 
 
 def region_span(survey: dict[str, Any]) -> float:
-    """Learner steps the target region spans across: the side of a square (cube…) of its points."""
-    reached = int(np.asarray(survey["reached"]).sum())
-    return float(reached ** (1 / len(survey["shape"])) * survey["stride"]) if reached else 0.0
+    """Learner steps the target region spans across: the side of a square (cube…) of its points
+    one learner step apart (`region_points`, counted at the learner's step even where the
+    survey's grid is coarser)."""
+    return float(survey["region_points"] ** (1 / len(survey["shape"])))

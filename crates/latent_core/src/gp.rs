@@ -178,6 +178,12 @@ impl GpMap {
         self.alpha_t.nrows()
     }
 
+    /// The training inputs, q×N (one point per column): a GPLVM decoder's are the demos' latent
+    /// points (a sparse one's, its inducing inputs).
+    pub fn inputs(&self) -> &DMatrix<f64> {
+        &self.inputs
+    }
+
     /// Number of training points N.
     pub fn len(&self) -> usize {
         self.inputs.ncols()

@@ -520,6 +520,15 @@ pub fn latent_survey<'py>(
         out.set_item("moves", PyArray1::from_vec(py, moves(&s.moves_to_target)))?;
         out.set_item("moves_in_physics", PyArray1::from_vec(py, moves(&s.moves_in_physics)))?;
         out.set_item("blocked", PyArray1::from_vec(py, s.blocked))?;
+        out.set_item("region_points", s.region_points)?;
+        if let Some(c) = s.closest {
+            let closest = PyDict::new(py);
+            closest.set_item("point", c.point)?;
+            closest.set_item("effectors", c.effectors)?;
+            closest.set_item("distance", c.distance)?;
+            closest.set_item("reward", c.reward)?;
+            out.set_item("closest", closest)?;
+        }
         Ok(out)
     })
 }

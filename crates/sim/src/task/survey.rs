@@ -11,6 +11,13 @@
 //! tipped in transit). A path either way is necessary for learning, not sufficient (the learner
 //! moves from where it is, not from rest); a start with no path has none in training either, up
 //! to the grid.
+//!
+//! A grid kept within its point budget runs at a stride of several learner steps, and a target
+//! region smaller than one of its cells falls between its points. So at a stride > 1 the cells
+//! where the region can be are looked into again at the learner's own step: the cells of the
+//! decoder's inputs (the demos' latent points, where the data is) and of the points closest to
+//! the target, closest first, within the grid's own budget. The region's size and the closest
+//! point come from there; a cell with a reached point counts as reached for the paths.
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -28,6 +35,10 @@ pub const DEFAULT_MAX_POINTS: usize = 20_000;
 
 /// Points classified between two looks at the cancel flag.
 const CHUNK: usize = 64;
+
+/// Cells looked into again at the learner's step besides the demos': the admissible points
+/// closest to the target.
+const REFINED_CLOSEST: usize = 16;
 
 /// A regular grid over a latent box, row-major (the last dimension fastest).
 #[derive(Debug, Clone, PartialEq)]
@@ -94,6 +105,47 @@ impl LatentGrid {
         }
     }
 
+    /// The index of the point nearest `z` (clamped into the grid).
+    fn nearest(&self, z: &[f64]) -> usize {
+        let mut index = 0;
+        for (k, z) in z.iter().enumerate() {
+            let at = ((z - self.low[k]) / self.spacing[k])
+                .round()
+                .clamp(0.0, (self.shape[k] - 1) as f64);
+            index = index * self.shape[k] + at as usize;
+        }
+        index
+    }
+
+    /// The points one learner step apart in the cell of point `index` (offsets of
+    /// −⌊stride/2⌋ … stride − ⌊stride/2⌋ − 1 steps per dimension around it, the cells tiling
+    /// the grid), within the grid's span, flat, `dim` values each.
+    fn cell(&self, index: usize) -> Vec<f64> {
+        let d = self.shape.len();
+        let s = self.stride as i64;
+        let mut centre = vec![0.0; d];
+        self.point(index, &mut centre);
+        let mut out = Vec::new();
+        let mut offset = vec![-(s / 2); d];
+        loop {
+            let z: Vec<f64> = (0..d)
+                .map(|k| centre[k] + offset[k] as f64 * self.spacing[k] / s as f64)
+                .collect();
+            let last = |k: usize| self.low[k] + (self.shape[k] - 1) as f64 * self.spacing[k];
+            if z.iter()
+                .enumerate()
+                .all(|(k, v)| *v >= self.low[k] - 1e-12 && *v <= last(k) + 1e-12)
+            {
+                out.extend(z);
+            }
+            let Some(k) = (0..d).rev().find(|&k| offset[k] < s - s / 2 - 1) else {
+                return out;
+            };
+            offset[k] += 1;
+            offset[k + 1..].fill(-(s / 2));
+        }
+    }
+
     /// The index `offset` points away from `index`, if inside the grid.
     fn neighbour(&self, index: usize, offset: &[i64]) -> Option<usize> {
         let (mut rest, mut out, mut scale) = (index, 0, 1);
@@ -134,6 +186,25 @@ pub struct Survey {
     pub blocked: Vec<bool>,
     /// With `physics`: [`Survey::moves_to_target`] through the moves that broke no rule.
     pub moves_in_physics: Vec<Option<usize>>,
+    /// Admissible points one learner step apart within the reach radius: the reached points at
+    /// stride 1; at a larger stride those found in the cells looked into again, plus
+    /// strideᵈ for each reached point whose cell was not.
+    pub region_points: usize,
+    /// The admissible point closest to the target found at either resolution, if any.
+    pub closest: Option<Closest>,
+}
+
+/// An admissible latent point and what its decoded posture gives at rest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Closest {
+    /// The latent point.
+    pub point: Vec<f64>,
+    /// The RMS effector distance to the target (m).
+    pub distance: f64,
+    /// The reward.
+    pub reward: f64,
+    /// The effector positions, (x, y, z) per effector.
+    pub effectors: Vec<f64>,
 }
 
 /// The grid of a [`survey`] and the learner's moves on it.
@@ -243,6 +314,15 @@ pub fn survey(
         all.effectors.extend(p.effectors);
         all.blocked.extend(p.blocked);
     }
+    let (region_points, closest) = if grid.stride() > 1 {
+        refine(task, demos, decoder, grid, &mut all, cancel)?
+    } else {
+        let closest = (0..n)
+            .filter(|&i| all.codes[i] == 0)
+            .min_by(|&a, &b| all.distance[a].total_cmp(&all.distance[b]))
+            .map(|i| closest_of(grid, &all, i, e));
+        (all.reached.iter().filter(|r| **r).count(), closest)
+    };
     let moves_to_target = fewest_moves(grid, &all.codes, &all.reached, &at.moves, &[]);
     let moves_in_physics = if physics {
         fewest_moves(grid, &all.codes, &all.reached, &at.moves, &all.blocked)
@@ -259,7 +339,95 @@ pub fn survey(
         reached: all.reached,
         effectors: all.effectors,
         grid: grid.clone(),
+        region_points,
+        closest,
     })
+}
+
+/// Point `i` of the grid's survey as a [`Closest`].
+fn closest_of(grid: &LatentGrid, all: &Part, i: usize, e: usize) -> Closest {
+    let mut point = vec![0.0; grid.shape().len()];
+    grid.point(i, &mut point);
+    Closest {
+        point,
+        distance: all.distance[i],
+        reward: all.reward[i],
+        effectors: all.effectors[i * e..(i + 1) * e].to_vec(),
+    }
+}
+
+/// Looks into cells of a grid at a stride > 1 again at the learner's step (module docs): the
+/// cells of the decoder's inputs and of the `REFINED_CLOSEST` admissible points closest to the
+/// target, closest first, at most as many points as the grid has. Marks the cells with a reached
+/// point reached in `all`; returns the region's points and the closest admissible point.
+fn refine(
+    task: &Arc<Task>,
+    demos: Option<&[Vec<f64>]>,
+    decoder: &GpMap,
+    grid: &LatentGrid,
+    all: &mut Part,
+    cancel: &AtomicBool,
+) -> Result<(usize, Option<Closest>)> {
+    let (n, d) = (grid.len(), grid.shape().len());
+    let e = 3 * task.config().effectors.len();
+    let mut admissible: Vec<usize> = (0..n).filter(|&i| all.codes[i] == 0).collect();
+    admissible.sort_by(|&a, &b| all.distance[a].total_cmp(&all.distance[b]).then(a.cmp(&b)));
+    let mut cells: Vec<usize> = decoder
+        .inputs()
+        .column_iter()
+        .map(|z| grid.nearest(z.as_slice()))
+        .collect();
+    cells.extend(admissible.iter().take(REFINED_CLOSEST));
+    cells.sort_by(|&a, &b| all.distance[a].total_cmp(&all.distance[b]).then(a.cmp(&b)));
+    cells.dedup();
+    cells.truncate((n / grid.stride().pow(d as u32)).max(1));
+    let found = cells
+        .par_iter()
+        .map_init(
+            || TaskPlant::new(Arc::clone(task), demos),
+            |plant, &cell| {
+                let plant = plant.as_mut().map_err(|err| task_error(task, err.to_string()))?;
+                if cancel.load(Ordering::Relaxed) {
+                    return Err(task_error(task, "the survey was cancelled".to_string()));
+                }
+                let mut q = vec![0.0; decoder.output_dim()];
+                let mut scratch = decoder.scratch();
+                let (mut reached, mut best): (usize, Option<Closest>) = (0, None);
+                for z in grid.cell(cell).chunks_exact(d) {
+                    decoder.mean_into(z, &mut q, &mut scratch);
+                    if plant.reset(&q).is_some() {
+                        continue;
+                    }
+                    reached += usize::from(plant.reached_target());
+                    let distance = plant.rms_distance();
+                    if best.as_ref().is_none_or(|b| distance < b.distance) {
+                        best = Some(Closest {
+                            point: z.to_vec(),
+                            distance,
+                            reward: plant.reward(),
+                            effectors: plant.effectors()[..e].to_vec(),
+                        });
+                    }
+                }
+                Ok((reached, best))
+            },
+        )
+        .collect::<Result<Vec<_>>>()?;
+    let mut looked = vec![false; n];
+    let mut region = 0;
+    let mut closest = admissible.first().map(|&i| closest_of(grid, all, i, e));
+    for (&cell, (reached, best)) in cells.iter().zip(found) {
+        looked[cell] = true;
+        region += reached;
+        all.reached[cell] |= reached > 0;
+        if let Some(b) = best
+            && closest.as_ref().is_none_or(|c| b.distance < c.distance)
+        {
+            closest = Some(b);
+        }
+    }
+    let unlooked = (0..n).filter(|&i| all.reached[i] && !looked[i]).count();
+    Ok((region + unlooked * grid.stride().pow(d as u32), closest))
 }
 
 /// Whether the move `offset` from point `index`, run from rest there through the plant (one RL
@@ -364,6 +532,20 @@ mod tests {
         // Coarsened to keep at most 10 points: two steps apart, 3 × 3.
         let coarse = LatentGrid::at_step(&[0.0, -1.0], &[1.0, 1.0], &[0.25, 0.5], 10);
         assert_eq!((coarse.shape(), coarse.stride()), (&[3, 3][..], 2));
+    }
+
+    #[test]
+    fn a_cell_holds_the_points_a_learner_step_apart_around_its_point() {
+        // Stride 2 (a 3 × 3 grid over [0, 1] × [-1, 1] at steps 0.25, 0.5): offsets −1 and 0.
+        let coarse = LatentGrid::at_step(&[0.0, -1.0], &[1.0, 1.0], &[0.25, 0.5], 10);
+        assert_eq!(coarse.cell(4), vec![0.25, -0.5, 0.25, 0.0, 0.5, -0.5, 0.5, 0.0]);
+        // At the low corner only the points inside the grid's span.
+        assert_eq!(coarse.cell(0), vec![0.0, -1.0]);
+        assert_eq!(coarse.nearest(&[0.7, 0.4]), 4);
+        assert_eq!(coarse.nearest(&[-5.0, 9.0]), 2);
+        // Stride 3 along one axis: −1, 0, +1 steps.
+        let line = LatentGrid::at_step(&[0.0], &[6.0], &[1.0], 3);
+        assert_eq!((line.stride(), line.cell(1)), (3, vec![2.0, 3.0, 4.0]));
     }
 
     #[test]
