@@ -215,6 +215,26 @@ def test_the_failures_figure_shows_the_last_episodes_a_stopped_trial_ran(monkeyp
     assert titles == ["stopped: where the last 100 episodes of trial 0 failed (100)"]
 
 
+def test_a_stopped_trial_is_summarised_over_the_episodes_it_ran():
+    """results.json's per-trial summary of a trial the stopping rule ended after 400 of 1000
+    episodes: its last tenth is of the 400 (the zoo's iiwa-style arm had `mean_return_last` NaN
+    and `reached_last` 0 from the budget's unset tail)."""
+    from latentrl.experiments.runner import summarise_trial
+
+    budget, ran = 1000, 400
+    ends = np.full((1, budget), -1, dtype=np.int8)
+    ends[0, :ran] = 0
+    returns = np.full((1, budget), np.nan)
+    returns[0, :ran] = np.arange(ran)
+    reached = np.zeros((1, budget), bool)
+    reached[0, ran - 20:ran] = True
+    arrays = {"latent": returns, "latent_end": ends, "latent_reached": reached, "latent_passed": reached}
+    summary = summarise_trial(arrays, "latent", 0)
+    assert summary["window"] == 40 and summary["ends"]["timeout"] == ran
+    assert summary["mean_return_first"] == pytest.approx(19.5) and summary["mean_return_last"] == pytest.approx(379.5)
+    assert summary["reached_last"] == pytest.approx(0.5) and summary["passed_last"] == pytest.approx(0.5)
+
+
 def test_a_run_reads_back_under_a_version_with_a_new_model_parameter(runs, monkeypatch):
     """Issue #38: a run's GPLVM is identified by the arrays its gplvm.npz holds, not by how this
     version would write them: a parameter added since (here `future`, None) is not a changed

@@ -182,12 +182,15 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
 
 def summarise_trial(arrays: Mapping[str, np.ndarray], name: str, trial: int) -> dict[str, Any]:
     """Per-trial figures for results.json: early/late mean return, end counts, reach and pass
-    rates; with frozen test episodes also `test_success` (share that reached the target),
-    `test_passed`, their mean return and end counts."""
-    returns = arrays[array_key(name, "returns")][trial]
+    rates over the episodes the trial ran (a trial the stopping rule ended ran fewer than its
+    budget; the rest are unset, end −1); with frozen test episodes also `test_success` (share
+    that reached the target), `test_passed`, their mean return and end counts."""
     ends = arrays[array_key(name, "ends")][trial]
-    reached = arrays[array_key(name, "reached")][trial]
-    passed = arrays[array_key(name, "passed")][trial]
+    ran = int((ends >= 0).sum()) or len(ends)
+    ends = ends[:ran]
+    returns = arrays[array_key(name, "returns")][trial][:ran]
+    reached = arrays[array_key(name, "reached")][trial][:ran]
+    passed = arrays[array_key(name, "passed")][trial][:ran]
     window = max(1, len(returns) // 10)
     summary: dict[str, Any] = {
         "mean_return_first": float(returns[:window].mean()),
