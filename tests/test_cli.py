@@ -349,13 +349,15 @@ def test_plot_redraws_the_finished_trials_of_a_partial_run(tmp_path):
 
 def test_resume_names_what_is_wrong_with_returns_npz(tmp_path):
     """Issue #38's probe: a returns.npz without an array was a KeyError traceback, one of strings a
-    TypeError traceback, one that is not a zip a message without the file."""
+    TypeError traceback, one that is not a zip or of end codes 99 a message without the file."""
     out = tmp_path / "run"
     first = latentrl("run", "exp1", "--no-progress", *TINY_RUNS["exp1"], "--out", str(out))
     assert first.returncode == 0, first.stderr
     saved = dict(np.load(out / "returns.npz"))
     edits = {"latent_end missing": ({k: v for k, v in saved.items() if k != "latent_end"}, "latent_end is missing"),
              "strings": ({**saved, "latent": saved["latent"].astype(str)}, "latent holds <U"),
+             "end code 99": ({**saved, "latent_end": np.full_like(saved["latent_end"], 99)},
+                             "latent_end holds values other than end codes"),
              "not a zip": (None, "not a readable NPZ file")}
     for name, (arrays, message) in edits.items():
         if arrays is None:

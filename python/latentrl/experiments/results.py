@@ -19,7 +19,7 @@ import numpy as np
 
 from latentrl._base import atomic_write, read_npz
 from latentrl._files import MAX_JSON_BYTES, read_text
-from latentrl.task import changed_since, ran_with
+from latentrl.task import changed_since, end_reasons, ran_with
 
 if TYPE_CHECKING:  # the GPLVM (and SciPy) load with the first run read back, not with `--help`
     from latentrl.gplvm import GPLVM
@@ -302,6 +302,10 @@ class RunFolder:
                 if arrays[key].shape != want:
                     raise ValueError(f"{self.path}/returns.npz: {key} has shape {arrays[key].shape}, the preset asks "
                                      f"for {want} (trials, episodes); it belongs to another run")
+                codes = len(end_reasons())
+                if what == "ends" and not np.isin(arrays[key], np.arange(-1, codes)).all():
+                    raise ValueError(f"{self.path}/returns.npz: {key} holds values other than end codes "
+                                     f"(integers in -1..{codes - 1}); restore the file, or start a new run with --out")
 
     def check_inputs(self, now: Mapping[str, str]) -> None:
         """`check_inputs` of the digests the run recorded against `now`'s."""
