@@ -18,6 +18,10 @@ per trial, or per `batch` trials, of every cell. Either way the runner stores ea
 its cell's results as it arrives (`run_rl(execute=…)`), atomically; a trial's RNG depends on
 the cell's base seed and the trial index alone, so both backends write the same bits, and
 `resume` skips the finished trials whichever backend ran them.
+
+The module has three parts: the description (`Sweep`, `Cell`, `load_sweep`: every value checked
+on construction), running it (`run_sweep`, the local backend) and the summary (`write_summary`,
+its figure drawn with matplotlib, the `[plot]` extra, imported when it is drawn).
 """
 
 from __future__ import annotations
