@@ -144,3 +144,30 @@ def test_demos_in_degrees_are_refused_naming_the_file_posture_and_joint(tmp_path
         assert f"{demos}: posture 3 (counting from 0) has {joint} = 9" in result.stderr
         assert "look like degrees" in result.stderr
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_a_full_disk_names_the_file_and_a_new_run_leaves_no_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                                                   capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue #38's probe: `latentrl train --out` on a full disk said "[Errno 28] No space left on
+    device" without the file and left a run folder holding gplvm.npz and no trial."""
+    import errno
+
+    from latentrl import _base, cli
+
+    def full(fh: object) -> None:
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    with pytest.raises(OSError, match=r"cannot write .*results\.json: No space left on device"):
+        _base.atomic_write(tmp_path / "results.json", full)
+    assert list(tmp_path.iterdir()) == []  # the temporary file is gone too
+
+    from latentrl.experiments import results
+
+    monkeypatch.setattr(results, "atomic_write",
+                        lambda path, write: _base.atomic_write(path, full if Path(path).name == "results.json" else write))
+    out = tmp_path / "run"
+    code = cli.main(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--quick",
+                     "--trials", "1", "--episodes", "2", "--test-episodes", "0", "--no-progress", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 1 and f"cannot write {out / 'results.json'}: No space left on device" in err, err
+    assert not out.exists(), (err, sorted(p.name for p in out.iterdir()))

@@ -41,16 +41,21 @@ def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
     """Calls `write` (its result is ignored) on a temporary file beside `path` (creating
     missing parent directories), flushes it to disk, then renames it over `path`, so an
     interrupted write never leaves a half-written file. A process killed mid-write leaves
-    only `.{name}.<hex>.tmp` behind."""
+    only `.{name}.<hex>.tmp` behind. An OSError (a full disk, a read-only folder) names `path`."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
     try:
+        path.parent.mkdir(parents=True, exist_ok=True)
         with open(tmp, "xb") as fh:
             write(fh)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
+    except OSError as err:
+        tmp.unlink(missing_ok=True)
+        if str(path) in str(err):
+            raise
+        raise type(err)(err.errno, f"cannot write {path}: {err.strerror or err}") from err
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise

@@ -144,38 +144,45 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
         folder.check_continued(meta, built.learners, built.info, arrays)
     arrays[PRESET_KEY] = np.array(json.dumps(as_saved(plan), sort_keys=True))
     chunk = chunk or worker_threads()
-    if built.model is not None and (meta is None or not folder.model_path.exists()):
-        out.mkdir(parents=True, exist_ok=True)
-        built.model.save(folder.model_path)
-    if meta is None:
-        meta = {"preset": plan, "environment": environment(), "setup": built.info, "wall_time_s": 0.0}
-    for name in built.learners:
-        for key in PER_EPISODE:
-            arrays.setdefault(array_key(name, key), _empty(key, preset.trials, preset.episodes))
-    todo = [
-        (name, t)
-        for name in built.learners
-        for t in range(preset.trials)
-        if arrays[array_key(name, "ends")][t, 0] < 0
-    ]
-    bar = progress_bar(total=len(todo) * episodes_per_trial(preset), unit="ep", disable=not progress, desc="episodes")
-    meta.setdefault("trials", {})
+    fresh = meta is None
     try:
-        for name, first, n, result in execute(built, _chunks(todo, chunk), bar.update):
-            for i, t in enumerate(range(first, first + n)):
-                for key in PER_EPISODE:
-                    arrays[array_key(name, key)][t] = result[key][i]
-                for key in PER_TRIAL:
-                    value = result.get(key)
-                    if value is not None and value[i].size:
-                        arrays.setdefault(array_key(name, key), _unset(value, preset.trials))[t] = value[i]
-                meta["trials"].setdefault(name, {})[str(t)] = summarise_trial(arrays, name, t)
-            meta["wall_time_s"] += time.perf_counter() - started
-            meta["peak_rss_mib"] = max(meta.get("peak_rss_mib", 0.0), peak_rss_mib())
-            started = time.perf_counter()
-            _save(meta_path, arrays_path, meta, arrays)
-    finally:
-        bar.close()
+        if built.model is not None and (meta is None or not folder.model_path.exists()):
+            out.mkdir(parents=True, exist_ok=True)
+            built.model.save(folder.model_path)
+        if meta is None:
+            meta = {"preset": plan, "environment": environment(), "setup": built.info, "wall_time_s": 0.0}
+        for name in built.learners:
+            for key in PER_EPISODE:
+                arrays.setdefault(array_key(name, key), _empty(key, preset.trials, preset.episodes))
+        todo = [
+            (name, t)
+            for name in built.learners
+            for t in range(preset.trials)
+            if arrays[array_key(name, "ends")][t, 0] < 0
+        ]
+        bar = progress_bar(total=len(todo) * episodes_per_trial(preset), unit="ep", disable=not progress, desc="episodes")
+        meta.setdefault("trials", {})
+        try:
+            for name, first, n, result in execute(built, _chunks(todo, chunk), bar.update):
+                for i, t in enumerate(range(first, first + n)):
+                    for key in PER_EPISODE:
+                        arrays[array_key(name, key)][t] = result[key][i]
+                    for key in PER_TRIAL:
+                        value = result.get(key)
+                        if value is not None and value[i].size:
+                            arrays.setdefault(array_key(name, key), _unset(value, preset.trials))[t] = value[i]
+                    meta["trials"].setdefault(name, {})[str(t)] = summarise_trial(arrays, name, t)
+                meta["wall_time_s"] += time.perf_counter() - started
+                meta["peak_rss_mib"] = max(meta.get("peak_rss_mib", 0.0), peak_rss_mib())
+                started = time.perf_counter()
+                _save(meta_path, arrays_path, meta, arrays)
+        finally:
+            bar.close()
+    except OSError:  # a full disk, a folder gone read-only: a new run that saved no trial leaves nothing
+        if fresh and not meta_path.exists():
+            folder.model_path.unlink(missing_ok=True)
+            arrays_path.unlink(missing_ok=True)
+        raise
     figures(preset, arrays, out, out)
     return meta
 
