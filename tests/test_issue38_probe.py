@@ -171,3 +171,26 @@ def test_a_full_disk_names_the_file_and_a_new_run_leaves_no_folder(tmp_path: Pat
     err = capsys.readouterr().err
     assert code == 1 and f"cannot write {out / 'results.json'}: No space left on device" in err, err
     assert not out.exists(), (err, sorted(p.name for p in out.iterdir()))
+
+
+@pytest.mark.parametrize("argv0", ["/usr/local/bin/latentrl", "my_script.py"])
+def test_ctrl_c_while_the_command_imports_is_its_own_message(argv0: str) -> None:
+    """Issue #38's probe: SIGINT in a command's first ~0.3 s, while Python still imported latentrl,
+    printed the interpreter's KeyboardInterrupt traceback. Here the interrupt lands inside
+    `import latentrl` (an import hook raises it at `latentrl.gplvm`): the `latentrl` command says
+    it was interrupted and exits 130; any other program gets its KeyboardInterrupt as ever."""
+    child = f"""
+import sys
+class Interrupt:
+    def find_spec(self, name, path=None, target=None):
+        if name == "latentrl.gplvm":
+            raise KeyboardInterrupt
+sys.meta_path.insert(0, Interrupt())
+sys.argv[0] = {argv0!r}
+import latentrl
+"""
+    result = subprocess.run([sys.executable, "-c", child], capture_output=True, text=True, timeout=120)
+    if argv0.endswith("latentrl"):
+        assert (result.returncode, result.stderr) == (130, "latentrl: interrupted; nothing was written\n")
+    else:
+        assert result.returncode != 0 and "Traceback" in result.stderr and "KeyboardInterrupt" in result.stderr

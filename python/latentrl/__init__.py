@@ -1,21 +1,40 @@
 """latentrl: reinforcement learning in the latent space of demonstrated postures."""
 
-from latentrl._base import NotFittedError
-from latentrl._native import (
-    GpMap,
-    InternalError,
-    InvalidInputError,
-    LatentrlError,
-    NumericalError,
-    __version__,
-)
-from latentrl.demos import Demonstrations, load_demos, save_demos
-from latentrl.gplvm import GPLVM
-from latentrl.pca import PCA
-from latentrl.task import Task
-from latentrl.train import LatentPolicy, train_latent_policy
+import sys as _sys
 
-import latentrl.envs  # noqa: E402, F401  (registers the Gymnasium environments, as ale_py does)
+
+def _started_as_cli() -> bool:
+    """Whether this process is the `latentrl` command (`latentrl …` or `python -m latentrl …`)."""
+    argv = _sys.orig_argv
+    module = argv[argv.index("-m") + 1:][:1] if "-m" in argv else []
+    return _sys.argv[0].rsplit("/", 1)[-1] == "latentrl" or module == ["latentrl"]
+
+
+try:
+    from latentrl._base import NotFittedError
+    from latentrl._native import (
+        GpMap,
+        InternalError,
+        InvalidInputError,
+        LatentrlError,
+        NumericalError,
+        __version__,
+    )
+    from latentrl.demos import Demonstrations, load_demos, save_demos
+    from latentrl.gplvm import GPLVM
+    from latentrl.pca import PCA
+    from latentrl.task import Task
+    from latentrl.train import LatentPolicy, train_latent_policy
+
+    import latentrl.envs  # noqa: F401  (registers the Gymnasium environments, as ale_py does)
+except BaseException as err:
+    # Ctrl-C while the command still imports (its first ~0.3 s): the command's own message and
+    # exit code, not the interpreter's traceback (or the native module's "initialization failed").
+    # A program that imports latentrl gets its KeyboardInterrupt as ever.
+    if (isinstance(err, KeyboardInterrupt) or isinstance(err.__context__, KeyboardInterrupt)) and _started_as_cli():
+        print("latentrl: interrupted; nothing was written", file=_sys.stderr)
+        raise SystemExit(130) from None
+    raise
 
 __all__ = [
     "GPLVM",
