@@ -172,6 +172,18 @@ def test_a_full_disk_names_the_file_and_a_new_run_leaves_no_folder(tmp_path: Pat
     assert code == 1 and f"cannot write {out / 'results.json'}: No space left on device" in err, err
     assert not out.exists(), (err, sorted(p.name for p in out.iterdir()))
 
+    # The disk full only when the figures are drawn: the run is saved, and the message says how to
+    # draw them again.
+    from latentrl import plots
+
+    monkeypatch.setattr(results, "atomic_write", _base.atomic_write)
+    monkeypatch.setattr(plots, "atomic_write", lambda path, write: _base.atomic_write(path, full))
+    code = cli.main(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--quick",
+                     "--trials", "1", "--episodes", "2", "--test-episodes", "0", "--no-progress", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 1 and f"the run's results are saved in {out}: `latentrl plot {out}`" in err, err
+    assert (out / "results.json").exists() and (out / "returns.npz").exists()
+
 
 @pytest.mark.parametrize("argv0", ["/usr/local/bin/latentrl", "my_script.py"])
 def test_ctrl_c_while_the_command_imports_is_its_own_message(argv0: str) -> None:

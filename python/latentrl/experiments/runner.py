@@ -183,7 +183,11 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
             folder.model_path.unlink(missing_ok=True)
             arrays_path.unlink(missing_ok=True)
         raise
-    figures(preset, arrays, out, out)
+    try:
+        figures(preset, arrays, out, out)
+    except OSError as err:  # e.g. a full disk: the trials are saved, only figures are missing
+        raise type(err)(err.errno, f"{err.strerror or err}; the run's results are saved in {out}: `latentrl plot "
+                                   f"{out}` draws its figures again") from err
     return meta
 
 
