@@ -957,6 +957,8 @@ def no_partial(path: Path) -> Callable[[subprocess.CompletedProcess[str]], str |
     def check(result: subprocess.CompletedProcess[str]) -> str | None:
         if result.returncode == 0:
             return None
+        if path.is_dir() and (path / "results.json").is_file() and "results are saved" in result.stderr:
+            return None  # the trials were saved whole before the disk filled; the message says so
         if path.is_file() or (path.is_dir() and any(p.name != "lost+found" for p in path.rglob("*") if p.is_file())):
             return "half-written"
         return None
