@@ -1249,6 +1249,9 @@ def main() -> int:
     parser.add_argument("--markdown", type=Path, help="write the table here")
     parser.add_argument("--json", type=Path, help="write the outcomes here")
     args = parser.parse_args()
+    # A probe started in the background of a shell without job control inherits SIGINT ignored,
+    # and so would every command it signals (Python keeps an ignored SIGINT ignored): restore it.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     where = args.base or Path(tempfile.mkdtemp(prefix="hp_base_"))
     where.mkdir(parents=True, exist_ok=True)
     base = build_base(where)
