@@ -13,6 +13,7 @@ import io
 import json
 import math
 import tempfile
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +22,7 @@ import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
+from run_folder_readers import FILES, json_mutations, make_folder, npz_mutations, read_file, read_mutated
 
 import latentrl
 from latentrl import GPLVM, PCA, Task, _native, load_demos
@@ -503,3 +505,118 @@ def test_extreme_scales_give_finite_results_or_errors(
     model = attempt(GPLVM(2, max_iter=3).fit, data)
     if model is not None:
         assert all_finite(model.Z_, model.theta_, model.inverse_transform(model.Z_), model.transform(data))
+
+
+# ---------------------------------------------------------------------------------------------
+# The run-folder readers (issue #38): results.json, returns.npz, gplvm.npz, policy.npz,
+# rollout.json and rollout.npz of a tiny `latentrl train` run, each mutated and read back by every
+# reader of it (tests/run_folder_readers.py); fuzz/fuzz_run_folder.py is the atheris target.
+
+@pytest.fixture(scope="module")
+def run_folder(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, bytes]]:
+    """A tiny train run and rollout (`run_folder_readers.make_folder`, ~4 s) and its files' bytes."""
+    root = make_folder(tmp_path_factory.mktemp("run_folder"))
+    return root, {name: (root / name).read_bytes() for name in FILES}
+
+
+def test_the_intact_run_folder_reads(run_folder: tuple[Path, dict[str, bytes]]) -> None:
+    root, _ = run_folder
+    for name in FILES:
+        read_file(root, name)
+
+
+@settings(FUZZ, max_examples=6 * settings().max_examples)
+@given(data=st.data(), name=st.sampled_from(FILES))
+def test_run_folder_readers_mutated_files(run_folder: tuple[Path, dict[str, bytes]], data: st.DataObject,
+                                          name: str) -> None:
+    """Each file of a run folder mutated (JSON: a value deleted, retyped, nested, odd; NPZ: an
+    array dropped, renamed, retyped, reshaped, odd values; either: cut or flipped bytes) is read
+    by every reader of it, or refused with a ValueError or OSError naming the file (or the
+    folder); never another exception or NaN where the run stored numbers (issue #38)."""
+    root, original = run_folder
+    blob = original[name]
+    mutated = data.draw(json_mutations(blob.decode()) if name.endswith(".json") else npz_mutations(blob))
+    event(f"{name}: {read_mutated(root, name, mutated, blob)}")
+
+
+def edited_npz(path: Path, **changes: Any) -> None:
+    """Rewrites the NPZ at `path` with arrays replaced (a value), added, or dropped (None)."""
+    with np.load(path) as npz:
+        arrays = {k: npz[k] for k in npz.files}
+    for key, value in changes.items():
+        if value is None:
+            del arrays[key]
+        else:
+            arrays[key] = value
+    np.savez(path, **arrays)
+
+
+def corrupt_header(path: Path) -> None:
+    """`path` an NPZ whose one array's header has an unclosed parenthesis (its CRC right)."""
+    buffer = io.BytesIO()
+    np.save(buffer, np.zeros((2, 3)))
+    npy = buffer.getvalue().replace(b"(2, 3)", b"(2, 3 ")
+    with zipfile.ZipFile(path, "w") as archive:
+        archive.writestr("latent.npy", npy)
+
+
+def unknown_compression(path: Path) -> None:
+    """`path`'s first zip member marked with compression method 99 (no such method)."""
+    blob = bytearray(path.read_bytes())
+    blob[blob.index(b"PK\x03\x04") + 8] = 99
+    blob[blob.index(b"PK\x01\x02") + 10] = 99
+    path.write_bytes(bytes(blob))
+
+
+def edited_json(path: Path, **changes: Any) -> None:
+    path.write_text(json.dumps({**json.loads(path.read_text()), **changes}))
+
+
+# Issue #38: what the run-folder fuzzers found, each once another exception (or NaN drawn silently).
+FOUND = {
+    "preset_json not JSON (JSONDecodeError naming no file)": (
+        "out/returns.npz", lambda p: edited_npz(p, preset_json=np.array("{")), r"returns\.npz: preset_json is not"),
+    "preset_json a number (TypeError)": (
+        "out/returns.npz", lambda p: edited_npz(p, preset_json=np.array("1")), r"returns\.npz: preset_json is not"),
+    "an array of another number of trials (IndexError)": (
+        "out/returns.npz", lambda p: edited_npz(p, latent_mean_state=np.zeros((2, 3, 2))),
+        r"returns\.npz: latent_mean_state: expected one row per trial"),
+    "NaN weights (V drawn from NaN)": (
+        "out/returns.npz", lambda p: edited_npz(p, latent_weights=np.full((1, 4), np.nan)),
+        r"returns\.npz: latent_weights of trial 0 holds NaN"),
+    "no recorded paths (a message naming no file)": (
+        "out/returns.npz", lambda p: edited_npz(p, latent_paths=np.zeros((1, 0, 2, 2))),
+        r"returns\.npz: --episode 2: the run recorded training episodes \[\]"),
+    "an array header with an unclosed parenthesis (TokenError)": (
+        "out/returns.npz", corrupt_header, r"returns\.npz: not a readable NPZ file"),
+    "an unknown compression method (NotImplementedError)": (
+        "out/gplvm.npz", unknown_compression, r"gplvm\.npz: not a readable NPZ file"),
+    "n_features_in_ infinite (OverflowError)": (
+        "out/gplvm.npz", lambda p: edited_npz(p, n_features_in_=np.array(np.inf)), r"gplvm\.npz: inconsistent"),
+    "Z_ one-dimensional (IndexError)": (
+        "out/gplvm.npz", lambda p: edited_npz(p, Z_=np.zeros(5)), r"gplvm\.npz: inconsistent .*Z_"),
+    "a policy's task a JSON list (TypeError)": (
+        "out/policy.npz", lambda p: edited_npz(p, task=np.array("[]")), r"policy\.npz: its task is not a table"),
+    "a policy's record without its ends (KeyError in report)": (
+        "out/policy.npz", lambda p: edited_npz(p, **{"record.ends": None}), r"policy\.npz: .*record\.ends"),
+    "a rollout's policy_from_out a list (TypeError)": (
+        "rollout/rollout.json", lambda p: edited_json(p, policy_from_out=[]), r"rollout\.json: policy_from_out must"),
+    "a rollout's trials a number (TypeError)": (
+        "rollout/rollout.json", lambda p: edited_json(p, trials=3), r"rollout\.json: trials must be a list"),
+    "a rollout's trials without the one asked for (a message naming no file)": (
+        "rollout/rollout.json", lambda p: edited_json(p, trials=[]), r"--trial 0: the rollout in .*rollout ran trials"),
+}
+
+
+@pytest.mark.parametrize("found", sorted(FOUND))
+def test_what_the_run_folder_fuzzers_found_is_refused_naming_the_file(
+        run_folder: tuple[Path, dict[str, bytes]], found: str) -> None:
+    root, original = run_folder
+    name, edit, says = FOUND[found]
+    path = root / name
+    try:
+        edit(path)
+        with pytest.raises(ValueError, match=says):
+            read_file(root, name)
+    finally:
+        path.write_bytes(original[name])

@@ -8,6 +8,8 @@ import contextlib
 import inspect
 import json
 import os
+import struct
+import tokenize
 import uuid
 import warnings
 import zipfile
@@ -125,7 +127,10 @@ def read_npz(path: PathLike, keys: Collection[str] | None = None) -> dict[str, N
                 return {key: npz[key] for key in npz.files if keys is None or key in keys}
         except _TooLarge as err:
             raise ValueError(f"refused NPZ file: {err}") from None
-        except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error) as err:
+        # Issue #38: a flipped byte can also name an unknown compression method (NotImplementedError),
+        # spoil an array header (tokenize's TokenError, SyntaxError) or a zip record (struct.error).
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error, NotImplementedError, SyntaxError,
+                tokenize.TokenError, struct.error) as err:
             raise ValueError(f"not a readable NPZ file (corrupt or truncated?): {err}") from err
 
 
@@ -417,7 +422,7 @@ class Estimator:
         try:
             estimator = cls(**json.loads(str(arrays["params"])))
             estimator._restore(arrays)
-        except (KeyError, TypeError, ValueError) as err:
+        except (KeyError, TypeError, ValueError, OverflowError) as err:  # OverflowError: an infinite size
             raise ValueError(f"{path}: inconsistent {expected} file: {err}") from err
         return estimator
 

@@ -256,6 +256,20 @@ def check_replay_arrays(path: Path, arrays: dict[str, NDArray[Any]]) -> None:
             raise ValueError(f"{path}: {key} has {len(value)} trials, 'latent' {trials}")
 
 
+def check_rollout_meta(path: Path, meta: dict[str, Any]) -> None:
+    """ValueError naming `path` unless the fields of rollout.json a replay reads have their types:
+    `trials` a list of trial indices, `policy` (and `policy_from_out` where present) a path
+    (issue #38: a list as a path was a TypeError)."""
+    trials = meta.get("trials")
+    if not isinstance(trials, list) or not all(type(t) is int and t >= 0 for t in trials):
+        raise ValueError(f"{path}: trials must be a list of trial indices, got {trials!r:.80}")
+    if "policy" not in meta and "policy_from_out" not in meta:
+        raise ValueError(f"{path}: names no policy (neither policy nor policy_from_out)")
+    for key in ("policy", "policy_from_out"):
+        if key in meta and not (isinstance(meta[key], str) and meta[key] and "\0" not in meta[key]):
+            raise ValueError(f"{path}: {key} must be the path of a policy.npz, got {meta[key]!r:.80}")
+
+
 def rollout_episode(out: Path, policy: str, trial: int, episode: int, view: str | None = None) -> Recorded:
     """Episode `episode` of trial `trial` of the `policy` ("greedy", "softmax", "random") rollout
     that `latentrl rollout` wrote into `out`, with the saved policy it names."""
@@ -263,14 +277,15 @@ def rollout_episode(out: Path, policy: str, trial: int, episode: int, view: str 
     from latentrl.train import POLICIES, LatentPolicy
 
     meta = read_json(out / "rollout.json")
+    check_rollout_meta(out / "rollout.json", meta)
     if policy not in POLICIES or policy not in meta:
         ran = [p for p in POLICIES if p in meta]
         raise ValueError(f"--policy {policy}: the rollout in {out} ran {', '.join(ran)}")
     trials = list(meta["trials"])
     if trial not in trials:
-        raise ValueError(f"--trial {trial}: the rollout ran trials {trials}")
+        raise ValueError(f"--trial {trial}: the rollout in {out} ran trials {trials}")
     moved = out / meta.get("policy_from_out", "")  # the rollout and its run moved together
-    saved = LatentPolicy.load(moved if moved.is_file() else Path(meta["policy"]))
+    saved = LatentPolicy.load(moved if moved.is_file() or "policy" not in meta else Path(meta["policy"]))
     key, where = f"{policy}_paths", out / "rollout.npz"
     try:
         arrays = read_npz(where, keys=[key])
@@ -310,11 +325,18 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     folder = RunFolder(run_dir)
     arrays = folder.arrays()  # its errors name the file
     check_replay_arrays(folder.arrays_path, arrays)
-    rows, what = episode_path(arrays, trial, episode, test, preset.episodes)
+    try:
+        rows, what = episode_path(arrays, trial, episode, test, preset.episodes)
+    except ValueError as err:  # the request, or the arrays (issue #38: name the file they are in)
+        raise ValueError(f"{folder.arrays_path}: {err}") from None
     weights = arrays.get("latent_weights")
     if weights is None:
         raise ValueError(f"{run_dir}: the run kept no learnt weights to draw V from")
-    drawn = recorded(experiment, preset, run_dir, rows, np.asarray(weights)[trial], what, view)
+    weights = np.asarray(weights)[trial]
+    if not np.isfinite(weights).all():  # issue #38: V would be drawn from NaN without a word
+        raise ValueError(f"{folder.arrays_path}: latent_weights of trial {trial} holds NaN or infinite values (the "
+                         "trial did not finish, or the file was edited)")
+    drawn = recorded(experiment, preset, run_dir, rows, weights, what, view)
     return render(drawn, out, rerun, fps=fps, width=width, max_frames=max_frames)
 
 

@@ -279,6 +279,8 @@ class LatentPolicy:
 
     def end_counts(self, last: int | None = None) -> dict[str, int]:
         """How many of the (`last`) training episodes each trial ran ended each way."""
+        if "ends" not in self.record:
+            raise ValueError("this policy has no training record (record.ends): it was not made by training")
         run = [row[row >= 0] for row in np.asarray(self.record["ends"])]  # −1: after a trial stopped
         ends = np.concatenate([row if last is None else row[-last:] for row in run])
         names = end_reasons()
@@ -318,13 +320,22 @@ class LatentPolicy:
             raise ValueError(f"{path}: not a complete policy file (missing {missing})")
         try:
             keys = json.loads(str(arrays["task"]))
-        except ValueError as err:  # issue #38: the message names the file and the array
+        except (ValueError, RecursionError) as err:  # issue #38: the message names the file and the array
             raise ValueError(f"{path}: its task is not valid JSON ({err})") from None
-        task = Task.from_dict(keys, Path(str(arrays["task_dir"])), f"the task of {path}")
+        if not isinstance(keys, dict):
+            raise ValueError(f"{path}: its task is not a table of task keys (a JSON object), got {type(keys).__name__}")
+        try:
+            task = Task.from_dict(keys, Path(str(arrays["task_dir"])), f"the task of {path}")
+        except TypeError as err:  # a key of the wrong type: the file is damaged, not the call
+            raise ValueError(str(err)) from None
         if task.digest() != str(arrays["task_digest"]):
             raise ValueError(f"{path}: its task (or the task's URDF in {arrays['task_dir']}) changed since it was saved")
         model = GPLVM._from_arrays({k[6:]: v for k, v in arrays.items() if k.startswith("model.")}, str(path))
         record = {k[7:]: v for k, v in arrays.items() if k.startswith("record.")}
+        for part in (RECORD[:3], RECORD[3:]):  # issue #38: a record without its ends was a KeyError in `report`
+            lost = [f"record.{k}" for k in part if k not in record]
+            if any(k in record for k in part) and lost:
+                raise ValueError(f"{path}: its training record is incomplete (missing {lost})")
         try:
             return cls(task=task, model=model, demos=arrays["demos"], latent_low=arrays["latent_low"],
                        latent_high=arrays["latent_high"], weights=arrays["weights"], record=record)

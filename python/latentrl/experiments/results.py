@@ -219,8 +219,11 @@ class RunFolder:
         return self._arrays
 
     def finished(self) -> tuple[dict[str, np.ndarray], dict[str, int]]:
-        """`finished_trials` of the arrays."""
-        return finished_trials(self.arrays())
+        """`finished_trials` of the arrays (its errors name the file)."""
+        try:
+            return finished_trials(self.arrays())
+        except ValueError as err:
+            raise ValueError(f"{self.arrays_path}: {err}") from None
 
     def model(self) -> GPLVM | None:
         """The GPLVM saved in gplvm.npz, None if the run has none (saved before models were kept)."""
@@ -273,7 +276,7 @@ class RunFolder:
         """The arrays of a run being continued were computed with `plan`; a ValueError naming the
         edited fields otherwise (mixing would be silently wrong)."""
         if PRESET_KEY in arrays:
-            saved, now = json.loads(str(arrays[PRESET_KEY])), as_saved(plan)
+            saved, now = saved_preset(self.arrays_path, arrays[PRESET_KEY]), as_saved(plan)
             edited = edited_fields(saved, now, ran)
             if edited:
                 changes = ", ".join(f"{k}: {saved.get(k)!r} in returns.npz, {now.get(k)!r} in results.json" for k in edited)
@@ -324,6 +327,20 @@ class RunFolder:
                              "run with --out")
 
 
+def saved_preset(path: Path, value: np.ndarray) -> dict[str, Any]:
+    """The preset that returns.npz at `path` records (`PRESET_KEY`: a JSON object in a string
+    array), or a ValueError naming the file (issue #38: a mangled one was a JSONDecodeError that
+    named no file, or a TypeError)."""
+    try:
+        saved = json.loads(str(value)) if value.dtype.kind == "U" and value.ndim == 0 else None
+    except (ValueError, RecursionError):
+        saved = None
+    if not isinstance(saved, dict) or not isinstance(saved.get("task") or {}, dict):
+        raise ValueError(f"{path}: {PRESET_KEY} is not the JSON object of a preset (got {value.dtype} of shape "
+                         f"{value.shape}); restore the file, or start a new run with --out")
+    return saved
+
+
 def edited_fields(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any]) -> list[str]:
     """The preset fields that differ between `saved` and `now`. A task override that only
     restores what the trials ran with (`ran`: `task.ran_with` of the recorded task, empty if none
@@ -348,12 +365,23 @@ def check_inputs(recorded: Mapping[str, str], now: Mapping[str, str], out: Path)
 
 def finished_trials(arrays: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndarray], dict[str, int]]:
     """The rows of finished trials only, learner by learner (a partial run's unrun trials are
-    NaN or −1), and how many each learner has. Learners with none are left out."""
+    NaN or −1), and how many each learner has. Learners with none are left out. A ValueError
+    naming the array if a learner's end codes are not (trials, episodes) or one of its arrays has
+    another number of trials (issue #38: an IndexError)."""
     learners = [key for key in arrays if array_key(key, "ends") in arrays]
-    done = {name: arrays[array_key(name, "ends")][:, 0] >= 0 for name in learners}
+    done = {}
+    for name in learners:
+        ends = arrays[array_key(name, "ends")]
+        if ends.ndim != 2:
+            raise ValueError(f"{array_key(name, 'ends')}: expected end codes of shape (trials, episodes), got shape "
+                             f"{ends.shape}")
+        done[name] = ends[:, 0] >= 0 if ends.shape[1] else np.zeros(len(ends), dtype=bool)
     kept: dict[str, np.ndarray] = {}
     for key, value in arrays.items():
         owner = max((n for n in learners if key == n or key.startswith(n + "_")), key=len, default=None)
+        if owner is not None and (value.ndim == 0 or len(value) != len(done[owner])):
+            raise ValueError(f"{key}: expected one row per trial ({len(done[owner])}, as "
+                             f"{array_key(owner, 'ends')}), got shape {value.shape}")
         if owner is not None and done[owner].any():
             kept[key] = value[done[owner]]
     return kept, {name: int(mask.sum()) for name, mask in done.items() if mask.any()}
