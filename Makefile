@@ -119,10 +119,12 @@ fuzz: ## cargo fuzz the URDF parser + physics, or the mesh reader, for FUZZ_SECO
 		fuzz/corpus/$(FUZZ_TARGET) $(FUZZ_SEEDS) -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 $(FUZZ_DICT) \
 		-print_final_stats=1
 
-fuzz-py: build ## atheris on the demo-file and saved-model readers for FUZZ_SECONDS (180) s; installs atheris if missing
+fuzz-py: build ## atheris on the demo-file, saved-model and run-folder readers for FUZZ_SECONDS (180) s each; installs atheris if missing
 	@$(PY) -c "import atheris" 2> /dev/null || $(PY) -m pip install --quiet atheris
-	mkdir -p fuzz/corpus/demos
+	mkdir -p fuzz/corpus/demos fuzz/corpus/run_folder fuzz/artifacts
 	nice -n 10 $(PY) fuzz/fuzz_demos_models.py fuzz/corpus/demos -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1
+	nice -n 10 $(PY) fuzz/fuzz_run_folder.py fuzz/corpus/run_folder -max_total_time=$(FUZZ_SECONDS) \
+		-artifact_prefix=fuzz/artifacts/ -print_final_stats=1
 
 clean: ## remove the venv and build outputs
 	rm -rf $(VENV) target
