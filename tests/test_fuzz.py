@@ -595,6 +595,14 @@ FOUND = {
         "out/gplvm.npz", lambda p: edited_npz(p, n_features_in_=np.array(np.inf)), r"gplvm\.npz: inconsistent"),
     "Z_ one-dimensional (IndexError)": (
         "out/gplvm.npz", lambda p: edited_npz(p, Z_=np.zeros(5)), r"gplvm\.npz: inconsistent .*Z_"),
+    "Z_ complex (ComplexWarning, an error under pytest)": (
+        "out/gplvm.npz", lambda p: edited_npz(p, Z_=np.zeros((5, 2), dtype=complex)), r"gplvm\.npz: inconsistent .*Z_"),
+    "a preset's task true (TypeError)": (
+        "out/results.json", lambda p: edited_json(p, preset={**json.loads(p.read_text())["preset"], "task": True}),
+        r"results\.json: preset\.task must be a JSON object"),
+    "a policy's latent box complex (ComplexWarning, an error under pytest)": (
+        "out/policy.npz", lambda p: edited_npz(p, latent_high=np.zeros(2, dtype=complex)),
+        r"policy\.npz: latent_high: expected real numbers"),
     "a policy's task a JSON list (TypeError)": (
         "out/policy.npz", lambda p: edited_npz(p, task=np.array("[]")), r"policy\.npz: its task is not a table"),
     "a policy's record without its ends (KeyError in report)": (

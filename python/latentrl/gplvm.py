@@ -356,13 +356,15 @@ class GPLVM(Estimator):
         # Files written before the back-constraint have no weights: their encoders had none;
         # files written before n_components="auto" have no relevances: those of their own axes;
         # files written before the sparse GPLVM have no inducing inputs: they are exact.
-        # A Z_ or θ of another shape is left to the checks of `_saved` (issue #38: an IndexError here).
-        if "Z_" in state and np.ndim(state["Z_"]) == 2:
-            Z = np.asarray(state["Z_"], dtype=np.float64)
+        # A Z_ or θ of another shape or dtype is left to the checks of `_saved` (issue #38: a 1-D Z_
+        # was an IndexError here, a complex one a ComplexWarning).
+        Z = np.asarray(state.get("Z_", ()))
+        if Z.ndim == 2 and Z.dtype.kind == "f":
             state = {"encoder_weights_": np.zeros_like(Z), "inducing_": np.zeros((0, Z.shape[1])),
                      "inducing_index_": np.zeros(0, dtype=np.intp), **state}
-            if "relevance_" not in state and np.shape(state.get("theta_", ())) == (3,):
-                state["relevance_"] = latent_relevance(Z, np.asarray(state["theta_"], dtype=np.float64))
+            theta = np.asarray(state.get("theta_", ()))
+            if "relevance_" not in state and theta.shape == (3,) and theta.dtype.kind == "f":
+                state["relevance_"] = latent_relevance(Z, theta)
         super()._restore(state)
 
     @staticmethod

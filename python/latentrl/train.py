@@ -184,6 +184,10 @@ class LatentPolicy:
         preset: Any = None,
         record: Mapping[str, NDArray[Any]] | None = None,
     ) -> None:
+        for name, value in (("demos", demos), ("latent_low", latent_low), ("latent_high", latent_high),
+                            ("weights", weights)):  # issue #38: complex values were cast with a warning
+            if np.asarray(value).dtype.kind not in "fiu":
+                raise ValueError(f"{name}: expected real numbers, got {np.asarray(value).dtype}")
         self.task, self.model, self.demos = task, model, np.asarray(demos, dtype=np.float64)
         joints = len(task.joint_names)
         if self.demos.ndim != 2 or self.demos.shape[1] != joints or not np.isfinite(self.demos).all():

@@ -69,7 +69,8 @@ def read_json(path: Path) -> dict[str, Any]:
     return payload
 
 
-RESULTS_OBJECTS = {"": ("preset", "setup", "trials", "environment"), "setup.": ("task", "gplvm", "inputs", "latent_box")}
+RESULTS_OBJECTS = {"": ("preset", "setup", "trials", "environment"), "setup.": ("task", "gplvm", "inputs", "latent_box"),
+                   "preset.": ("task",)}
 """The parts of a results.json that readers use, by where they sit: each must be a JSON object."""
 
 
