@@ -107,13 +107,14 @@ class Projection:
         decoder: GpMap,
         postures: NDArray[np.float64],
         *,
-        max_iter: int = 200,
-        margin: float = 0.5,
+        max_iter: int = ...,
+        margin: float = ...,
         tracking: bool = False,
     ) -> Projection:
         """The projection under `decoder` (a GpMap latent → posture) fitted to `postures` (N, D),
         with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`;
-        `tracking`: after a move, search from the commanded latent point (docs/encoders.md)."""
+        `tracking`: after a move, search from the commanded latent point (docs/encoders.md).
+        Defaults are the core's (`ProjectionConfig::DEFAULT`: 200 iterations, margin 0.5)."""
     def encode(self, postures: NDArray[np.float64]) -> NDArray[np.float64]:
         """Latent points (M, d) of `postures` (M, D), in parallel."""
     def encode_one(self, posture: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -154,10 +155,10 @@ class Sim:
         """Simulated time since the last reset (s)."""
     def reset(self, posture: NDArray[np.float64]) -> None:
         """Teleports the robot to `posture` (num_joints,) at rest and aims the servos at it."""
-    def reset_on_ground(self, posture: NDArray[np.float64], sole: str, clearance: float = 5e-4) -> None:
+    def reset_on_ground(self, posture: NDArray[np.float64], sole: str, clearance: float = ...) -> None:
         """Teleports a floating robot to `posture` at rest standing on the floor: the base is
         placed so that link `sole` lies flat, its lowest corner `clearance` m above the ground
-        (needs a `floor`)."""
+        (needs a `floor`; default `sim::fall::GROUND_CLEARANCE`, 0.5 mm)."""
     def base_position(self) -> NDArray[np.float64]:
         """World position (3,) of the root link's origin (the floating base)."""
     def fall_status(
@@ -431,14 +432,15 @@ def latent_survey(
     latent_low: ArrayLike,
     latent_high: ArrayLike,
     demos: NDArray[np.float64] | None = None,
-    max_points: int = 20000,
+    max_points: int = ...,
     physics: bool = False,
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
     """The task's latent space at rest on a grid at its learner step: per point the rule broken,
     reward, distance, reached, effectors, and the fewest learner moves to the target region;
     `region_points` (the region's points at the learner's step) and `closest` (the admissible
-    point closest to the target: point, effectors, distance, reward; absent if none)."""
+    point closest to the target: point, effectors, distance, reward; absent if none).
+    `max_points` defaults to `sim::task::survey::DEFAULT_MAX_POINTS` (20 000)."""
 
 def learner_values(
     learner: Mapping[str, object],

@@ -110,6 +110,32 @@ pub fn refused(z_target: &[f64], bounds: &Bounds<'_>, variance: Option<f64>) -> 
     }
 }
 
+/// [`refused`] for a caller's arrays: `z` inside `[low, high]` (one length each), and with
+/// `variance` and `threshold` given, the variance gate.
+pub fn refusal(
+    z: &[f64],
+    low: &[f64],
+    high: &[f64],
+    variance: Option<f64>,
+    threshold: Option<f64>,
+) -> crate::Result<Option<EndReason>> {
+    if z.len() != low.len() || high.len() != low.len() {
+        return Err(crate::CoreError::Argument(format!(
+            "z, low, high: expected one length, got {}, {}, {}",
+            z.len(),
+            low.len(),
+            high.len()
+        )));
+    }
+    let bounds = Bounds {
+        low,
+        high,
+        variance_threshold: threshold,
+        penalty: 0.0,
+    };
+    Ok(refused(z, &bounds, variance))
+}
+
 /// Steps 2–5 of the module docs towards the latent target `z_target`: box check, decode (and
 /// gate), one plant step, and — unless the plant ended the episode in a terminal state —
 /// encode the reached posture into `s.next`.

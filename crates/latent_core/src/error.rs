@@ -79,6 +79,10 @@ pub enum CoreError {
         /// The plant's error message.
         reason: String,
     },
+    /// A call's argument broke its limit (a run argument, a latent box corner, a memory cap);
+    /// the message names the argument and the limit.
+    #[error("{0}")]
+    Argument(String),
     /// An input larger than the core can hold: refused before anything is allocated.
     #[error("{what}: {size} points need a {size}×{size} kernel matrix ({gib:.1} GiB); the limit is {limit} points")]
     TooLarge {
@@ -95,6 +99,18 @@ pub enum CoreError {
 
 /// Result alias for the core.
 pub type Result<T> = std::result::Result<T, CoreError>;
+
+/// Fails with [`CoreError::Shape`] unless `values` holds `len` values, then as [`check_finite`].
+pub fn check_vector(what: &'static str, values: &[f64], len: usize) -> Result<()> {
+    if values.len() != len {
+        return Err(CoreError::Shape {
+            what,
+            expected: format!("({len},)"),
+            got: format!("({},)", values.len()),
+        });
+    }
+    check_finite(what, values)
+}
 
 /// Fails with [`CoreError::NonFinite`] at the first NaN or infinity in `values`.
 pub fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {

@@ -168,6 +168,16 @@ impl GpMap {
         explained
     }
 
+    /// Mean (p,) and variance at one point `x` (q,), checked: its length, finite values in and
+    /// out.
+    pub fn predict_one(&self, x: &[f64]) -> Result<(Vec<f64>, f64)> {
+        crate::error::check_vector("x", x, self.input_dim())?;
+        let mut mean = vec![0.0; self.output_dim()];
+        let variance = self.predict_into(x, &mut mean, &mut self.scratch());
+        check_prediction(&mean)?;
+        Ok((mean, variance))
+    }
+
     /// Input dimension q.
     pub fn input_dim(&self) -> usize {
         self.inputs.nrows()

@@ -31,13 +31,18 @@ pub struct ProjectionConfig {
     pub tracking: bool,
 }
 
+impl ProjectionConfig {
+    /// 200 iterations per stage, a margin of 0.5, no tracking.
+    pub const DEFAULT: Self = Self {
+        max_iter: 200,
+        margin: 0.5,
+        tracking: false,
+    };
+}
+
 impl Default for ProjectionConfig {
     fn default() -> Self {
-        Self {
-            max_iter: 200,
-            margin: 0.5,
-            tracking: false,
-        }
+        Self::DEFAULT
     }
 }
 

@@ -23,7 +23,8 @@ use crate::encode::Encode;
 use crate::episode::{EpisodeRecord, EpisodeScratch};
 use crate::error::{CoreError, Result};
 use crate::gp::GpMap;
-use crate::learner::{Learner, Phase};
+use crate::learner::{ActionRule, Learner, Phase};
+use crate::params::Kind;
 use crate::plant::Plant;
 use crate::space::StateSpace;
 
@@ -89,7 +90,117 @@ impl Default for TrialOptions {
     }
 }
 
+/// Most episode records one call may return (≈ 0.5 GB of per-episode arrays).
+pub const MAX_EPISODES: usize = 10_000_000;
+
+/// Most values of recorded paths one call may return (2 GiB of float64).
+pub const MAX_PATH_VALUES: usize = 1 << 28;
+
+/// The run arguments of a trial runner as a caller gave them: integers of any size, `None`
+/// for left out. [`TrialOptions::from_args`] checks them.
+#[derive(Debug, Clone, Default)]
+pub struct RunArgs {
+    /// Number of trials.
+    pub n_trials: i128,
+    /// Episodes per trial.
+    pub episodes: i128,
+    /// Base seed.
+    pub base_seed: i128,
+    /// Index of the first trial (0).
+    pub first_trial: Option<i128>,
+    /// Episode indices to record.
+    pub record_episodes: Vec<i128>,
+    /// Frozen test episodes (0).
+    pub test_episodes: Option<i128>,
+    /// Test-episode indices to record.
+    pub record_test_episodes: Vec<i128>,
+    /// Keep each trial's final weights.
+    pub keep_weights: bool,
+    /// Roll the episodes out frozen with this action rule's name ("greedy", "softmax",
+    /// "random"), starts as the frozen tests' if the flag is set.
+    pub rollout: Option<(String, bool)>,
+}
+
+/// `value` if it lies in `[min, max]`, else the error naming `name`.
+fn int_in(name: &str, value: i128, min: i128, max: i128) -> Result<i128> {
+    if value < min || value > max {
+        return argument(format!("{name} must lie in [{min}, {max}], got {value}"));
+    }
+    Ok(value)
+}
+
 impl TrialOptions {
+    /// The options of `args`, every argument checked against its limit (the messages name
+    /// the argument), and at most [`MAX_EPISODES`] episode records in all.
+    pub fn from_args(args: &RunArgs) -> Result<Self> {
+        let n_trials = int_in("n_trials", args.n_trials, 1, 1_000_000)? as usize;
+        let episodes = int_in("episodes", args.episodes, 1, 100_000_000)? as usize;
+        let base_seed = int_in("base_seed", args.base_seed, 0, u64::MAX as i128)? as u64;
+        let first_trial = match args.first_trial {
+            Some(v) => int_in("first_trial", v, 0, 1 << 40)? as usize,
+            None => 0,
+        };
+        let test_episodes = match args.test_episodes {
+            Some(v) => int_in("test_episodes", v, 0, 100_000_000)? as usize,
+            None => 0,
+        };
+        let total = n_trials as u128 * (episodes + test_episodes) as u128;
+        if total > MAX_EPISODES as u128 {
+            return argument(format!(
+                "n_trials × (episodes + test_episodes) = {total} episode records in one call, more than {MAX_EPISODES}; \
+                 run fewer trials at a time (the runners save trial by trial)"
+            ));
+        }
+        let indices = |name: &str, list: &[i128], n: usize| -> Result<Vec<usize>> {
+            let name = format!("{name}[i]");
+            list.iter()
+                .map(|&e| Ok(int_in(&name, e, 0, n as i128 - 1)? as usize))
+                .collect()
+        };
+        let phase = match &args.rollout {
+            None => Phase::Train,
+            Some((name, test_starts)) => Phase::Rollout {
+                action: ActionRule::from_name(name).ok_or_else(|| {
+                    CoreError::Argument(format!("rollout must be one of {}, got {name:?}", ActionRule::kind()))
+                })?,
+                test_starts: *test_starts,
+            },
+        };
+        let options = TrialOptions {
+            n_trials,
+            first_trial,
+            episodes,
+            base_seed,
+            record_episodes: indices("record_episodes", &args.record_episodes, episodes)?,
+            keep_weights: args.keep_weights,
+            test_episodes,
+            record_test_episodes: indices("record_test_episodes", &args.record_test_episodes, test_episodes)?,
+            phase,
+        };
+        options.validate()?;
+        Ok(options)
+    }
+
+    /// The units of progress: `n_trials × (episodes + test_episodes)` episodes.
+    pub fn total_episodes(&self) -> usize {
+        self.n_trials * (self.episodes + self.test_episodes)
+    }
+
+    /// Refuses recorded paths too large to return ([`MAX_PATH_VALUES`]): `trials × recorded
+    /// episodes × (max_steps + 1) × row` values.
+    pub fn check_recording(&self, max_steps: usize, row: usize) -> Result<()> {
+        let records = self.record_episodes.len() + self.record_test_episodes.len();
+        let values = self.n_trials as u128 * records as u128 * (max_steps as u128 + 1) * row as u128;
+        if values > MAX_PATH_VALUES as u128 {
+            return argument(format!(
+                "recording {records} episodes of up to {max_steps} steps × {row} values in each of {} trials needs \
+                 {values} values, more than {MAX_PATH_VALUES} (2 GiB); record fewer episodes or run fewer trials at a time",
+                self.n_trials
+            ));
+        }
+        Ok(())
+    }
+
     /// Checks `n_trials, episodes ≥ 1` and that every recorded (test) episode exists.
     pub fn validate(&self) -> Result<()> {
         if self.n_trials == 0 {
@@ -190,17 +301,17 @@ where
         .collect()
 }
 
-/// A latent space: the GPLVM maps and the latent box.
-#[derive(Debug, Clone, Copy)]
+/// A latent space: the GPLVM maps and the latent box, checked by [`LatentArgs::check`].
+#[derive(Debug, Clone)]
 pub struct LatentSpace<'a> {
     /// Latent → posture GP map (GPLVM mean, Eq. 4).
     pub decoder: &'a GpMap,
     /// Posture → latent map (out-of-sample GP, back-constraint or iterative projection).
     pub encoder: &'a dyn Encode,
     /// Lower corner of the latent box.
-    pub low: &'a [f64],
+    pub low: Vec<f64>,
     /// Upper corner of the latent box.
-    pub high: &'a [f64],
+    pub high: Vec<f64>,
 }
 
 impl<'a> LatentSpace<'a> {
@@ -213,28 +324,102 @@ impl<'a> LatentSpace<'a> {
     }
 }
 
-/// Runs trials of the latent learner (`config`, `rules`; actions `config.actions`, RBF grid
-/// over the latent box) in `latent`, one plant per trial from `make_plant(trial)`: see
-/// [`run_trials`] for seeding, cancellation, progress and test episodes. A plant is built up
-/// front, so a bad plant or mismatched maps fail before any trial starts (a plant's error
-/// as [`CoreError::Plant`]).
-pub fn run_latent_trials<P, E, F>(
-    make_plant: F,
-    config: &crate::LearnerConfig,
-    rules: crate::EpisodeRules,
-    latent: &LatentSpace<'_>,
-    options: &TrialOptions,
-    cancel: &AtomicBool,
-    done: &AtomicUsize,
-) -> Result<Vec<TrialResult>>
-where
-    P: Plant,
-    E: std::fmt::Display,
-    F: Fn(usize) -> std::result::Result<P, E> + Sync,
-{
-    let make_plant = |trial| make_plant(trial).map_err(|e| CoreError::Plant { reason: e.to_string() });
-    let template = Learner::new(config, rules, latent.low, latent.high)?;
-    run_trials(&template, &latent.space(), make_plant, options, cancel, done)
+/// A corner of the latent box as a caller gave it: its numbers, or (`Err`) the name of the
+/// type that was not a 1-D array of numbers.
+pub type Corner = std::result::Result<Vec<f64>, String>;
+
+/// A latent space's parts as a caller gave them, each possibly left out.
+#[derive(Debug, Default)]
+pub struct LatentArgs<'a> {
+    /// Latent → posture.
+    pub decoder: Option<&'a GpMap>,
+    /// Posture → latent.
+    pub encoder: Option<&'a dyn Encode>,
+    /// Lower corner of the latent box.
+    pub low: Option<Corner>,
+    /// Upper corner of the latent box.
+    pub high: Option<Corner>,
+}
+
+fn argument<T>(message: String) -> Result<T> {
+    Err(CoreError::Argument(message))
+}
+
+impl<'a> LatentArgs<'a> {
+    /// Whether any part is given (Exp 1 runs its full-space learner when none is).
+    pub fn given(&self) -> bool {
+        self.decoder.is_some() || self.encoder.is_some() || self.low.is_some() || self.high.is_some()
+    }
+
+    /// The latent space: decoder and encoder given, corners of the decoder's input dimension,
+    /// finite, `high > low`. `context` ends the "is required" messages.
+    pub fn check(self, context: &str) -> Result<LatentSpace<'a>> {
+        let decoder = self.decoder(context)?;
+        let Some(encoder) = self.encoder else {
+            return argument(format!("encoder (posture → latent) is required {context}"));
+        };
+        let (low, high) = latent_box(decoder, self.low, self.high, context)?;
+        Ok(LatentSpace {
+            decoder,
+            encoder,
+            low,
+            high,
+        })
+    }
+}
+
+impl<'a> LatentArgs<'a> {
+    /// The decoder, required.
+    fn decoder(&self, context: &str) -> Result<&'a GpMap> {
+        self.decoder
+            .ok_or_else(|| CoreError::Argument(format!("decoder (a GpMap latent → posture) is required {context}")))
+    }
+
+    /// The decoder and the latent box, without an encoder (what a survey of the space needs).
+    pub fn check_box(self, context: &str) -> Result<(&'a GpMap, Vec<f64>, Vec<f64>)> {
+        let decoder = self.decoder(context)?;
+        let (low, high) = latent_box(decoder, self.low, self.high, context)?;
+        Ok((decoder, low, high))
+    }
+}
+
+/// The latent box `(low, high)` of `decoder`: both corners given, of its input dimension,
+/// finite, `high > low`. `context` ends the "is required" messages.
+fn latent_box(
+    decoder: &GpMap,
+    low: Option<Corner>,
+    high: Option<Corner>,
+    context: &str,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let dim = decoder.input_dim();
+    let corner = |name: &'static str, value: Option<Corner>| -> Result<Vec<f64>> {
+        let v = match value {
+            None => return argument(format!("{name} is required {context}")),
+            Some(Err(type_name)) => {
+                return argument(format!(
+                    "{name}: expected a 1-D array of {dim} numbers, got {type_name}"
+                ));
+            }
+            Some(Ok(v)) => v,
+        };
+        if v.len() != dim {
+            return argument(format!(
+                "{name}: expected shape ({dim},) (the decoder's input dimension), got ({},)",
+                v.len()
+            ));
+        }
+        crate::error::check_finite(name, &v)?;
+        Ok(v)
+    };
+    let low = corner("latent_low", low)?;
+    let high = corner("latent_high", high)?;
+    if let Some(k) = (0..dim).find(|&k| high[k] <= low[k]) {
+        return argument(format!(
+            "latent_high[{k}] = {} must exceed latent_low[{k}] = {}",
+            high[k], low[k]
+        ));
+    }
+    Ok((low, high))
 }
 
 fn run_one<P: Plant, F: Fn(usize) -> Result<P>>(
@@ -419,7 +604,6 @@ mod tests {
 
     #[test]
     fn rollouts_of_every_action_rule_meet_the_same_starts() {
-        use crate::learner::ActionRule;
         let config = crate::LearnerConfig {
             rbf_per_dim: 11,
             step: 1.0,

@@ -1,14 +1,14 @@
 //! Binding of `sim::bimanual`: Experiment 1 trials (the kinematic two-hand toy) in one call.
 
-use ::sim::bimanual::{BimanualConfig, BimanualLearner, run_bimanual_trials as run_core};
+use ::sim::bimanual::{BimanualConfig, BimanualLearner, BimanualTrials, check_tables};
 use latent_core::LearnerConfig;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{config_from, config_to};
+use crate::convert::{config_or_default, config_to};
 use crate::errors::{guard, to_py};
 use crate::projection::EncoderObject;
-use crate::runner::{RunArgs, episodes_in, gp_map, latent_args, pack_results, run_with_polling};
+use crate::runner::{RunArguments, latent_args, pack_results, run_with_polling};
 
 /// Runs Experiment 1 (docs/method.md §Experiment 1) trials in parallel in Rust and returns their
 /// records.
@@ -69,59 +69,27 @@ pub fn run_bimanual_trials<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         #[rustfmt::skip]
-        let run = RunArgs { n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
-                            record_test_episodes, return_weights, progress }.check()?;
-        let plant: BimanualConfig = plant
-            .filter(|p| !p.is_none())
-            .map_or(Ok(BimanualConfig::default()), |p| config_from("plant", p))?;
-        let config: LearnerConfig = learner
-            .filter(|l| !l.is_none())
-            .map_or(Ok(LearnerConfig::default()), |l| config_from("learner", l))?;
-        check_tables(&plant, &config)?;
-        let maps = [&decoder, &encoder].map(|m| m.as_ref().is_some_and(|m| !m.is_none()));
-        let corners = [latent_low, latent_high].map(|c| c.is_some_and(|c| !c.is_none()));
-        let (latent, encoder_object);
-        let bimanual = if maps.iter().chain(&corners).any(|&given| given) {
-            encoder_object = encoder
-                .filter(|e| !e.is_none())
-                .map(|e| EncoderObject::extract("encoder", &e))
-                .transpose()?;
-            let encoder = encoder_object.as_ref().map(EncoderObject::get);
-            latent = latent_args(
-                gp_map("decoder", &decoder)?,
-                encoder,
-                latent_low,
-                latent_high,
-                "for the latent learner",
-            )?;
-            BimanualLearner::Latent {
-                decoder: latent.decoder,
-                encoder: latent.encoder,
-                low: &latent.low,
-                high: &latent.high,
-            }
-        } else {
-            BimanualLearner::Full
-        };
-        // Validates both configurations and the grid before any thread starts.
-        let (template, _) = bimanual.build(&plant, &config).map_err(to_py)?;
-        let options = &run.options;
-        crate::runner::check_recording(options, plant.max_steps, 4)?;
-        let results = run_with_polling(py, episodes_in(options), run.progress.as_ref(), |cancel, done| {
-            run_core(&plant, &config, &bimanual, options, cancel, done).map_err(to_py)
+        let (options, progress) = RunArguments { n_trials, episodes, base_seed, first_trial, record_episodes,
+            test_episodes, record_test_episodes, return_weights, progress }.check(None)?;
+        let plant: BimanualConfig = config_or_default("plant", plant)?;
+        let config: LearnerConfig = config_or_default("learner", learner)?;
+        check_tables(&plant, &config).map_err(to_py)?;
+        let encoder = encoder.filter(|e| !e.is_none());
+        let encoder = encoder.map(|e| EncoderObject::extract("encoder", &e)).transpose()?;
+        let args = latent_args(decoder.as_ref(), encoder.as_ref(), latent_low, latent_high)?;
+        let latent = args.given().then(|| args.check("for the latent learner")).transpose();
+        let latent = latent.map_err(to_py)?;
+        let trials =
+            BimanualTrials::new(plant, config, BimanualLearner::new(latent.as_ref()), options).map_err(to_py)?;
+        let total = trials.options.total_episodes();
+        let results = run_with_polling(py, total, progress.as_ref(), |cancel, done| {
+            trials.run(cancel, done).map_err(to_py)
         })?;
-        let out = pack_results(py, &results, &template, options, 4)?;
-        out.set_item("plant", config_to(py, &plant)?)?;
-        out.set_item("learner", config_to(py, &config)?)?;
+        let out = pack_results(py, &results, &trials.template, &trials.options, 4)?;
+        out.set_item("plant", config_to(py, &trials.plant)?)?;
+        out.set_item("learner", config_to(py, &trials.config)?)?;
         Ok(out)
     })
-}
-
-/// Both configurations' rules, the errors named `plant.*` and `learner.*`.
-fn check_tables(plant: &BimanualConfig, learner: &LearnerConfig) -> PyResult<()> {
-    use latent_core::Params;
-    plant.check_fields("plant").map_err(|e| to_py(e.into()))?;
-    learner.check_fields("learner").map_err(|e| to_py(e.into()))
 }
 
 /// Experiment 1's configuration checked: `(plant, learner)` dicts with every key's effective
@@ -134,9 +102,11 @@ pub fn bimanual_config<'py>(
     learner: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     guard(|| {
-        let plant: BimanualConfig = plant.map_or(Ok(BimanualConfig::default()), |p| config_from("plant", p))?;
-        let learner: LearnerConfig = learner.map_or(Ok(LearnerConfig::default()), |l| config_from("learner", l))?;
-        check_tables(&plant, &learner)?;
+        let (plant, learner): (BimanualConfig, LearnerConfig) = (
+            config_or_default("plant", plant)?,
+            config_or_default("learner", learner)?,
+        );
+        check_tables(&plant, &learner).map_err(to_py)?;
         Ok((config_to(py, &plant)?, config_to(py, &learner)?))
     })
 }
@@ -155,7 +125,7 @@ impl PyBimanualPlant {
     #[pyo3(signature = (plant = None))]
     fn new(plant: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         guard(|| {
-            let config: BimanualConfig = plant.map_or(Ok(BimanualConfig::default()), |p| config_from("plant", p))?;
+            let config: BimanualConfig = config_or_default("plant", plant)?;
             Ok(Self {
                 inner: ::sim::BimanualPlant::new(config).map_err(to_py)?,
             })
@@ -221,20 +191,7 @@ pub fn latent_refusal(
     threshold: Option<f64>,
 ) -> PyResult<Option<u8>> {
     guard(|| {
-        if z.len() != low.len() || high.len() != low.len() {
-            return Err(crate::runner::invalid(format!(
-                "z, low, high: expected one length, got {}, {}, {}",
-                z.len(),
-                low.len(),
-                high.len()
-            )));
-        }
-        let bounds = latent_core::Bounds {
-            low: &low,
-            high: &high,
-            variance_threshold: threshold,
-            penalty: 0.0,
-        };
-        Ok(latent_core::refused(&z, &bounds, variance).map(|e| e.code()))
+        let refusal = latent_core::episode::refusal(&z, &low, &high, variance, threshold).map_err(to_py)?;
+        Ok(refusal.map(|e| e.code()))
     })
 }

@@ -86,6 +86,13 @@ pub fn config_from<T: DeserializeOwned>(what: &str, value: &Bound<'_, PyAny>) ->
     })
 }
 
+/// [`config_from`], or the configuration's defaults for None.
+pub fn config_or_default<T: DeserializeOwned + Default>(what: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<T> {
+    value
+        .filter(|v| !v.is_none())
+        .map_or(Ok(T::default()), |v| config_from(what, v))
+}
+
 /// A Python value as a TOML value, by its own type: a bool is never a number, a string never a
 /// bool (NumPy arrays and scalars through `tolist`). Err: (key path, what is wrong).
 fn toml_value(value: &Bound<'_, PyAny>, path: &str, depth: usize) -> Result<toml::Value, (String, String)> {

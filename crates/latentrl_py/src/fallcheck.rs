@@ -1,20 +1,13 @@
 //! Binding of `sim::fallcheck`: the fall check of a floating robot's task in one call.
 
-use ::sim::World;
-use ::sim::fallcheck::{FallCheckConfig, run_fall_check_observed};
+use ::sim::fallcheck::{FRAME_HEAD, REPORT_COLUMNS, run_task_fall_check};
 use nalgebra::DMatrix;
 use numpy::{PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{points, to_points};
-use crate::errors::{InvalidInputError, guard, sim_to_py};
+use crate::errors::{guard, sim_to_py};
 use crate::task::PyTask;
-
-/// Columns of the returned table, one row per target.
-const COLUMNS: usize = 7;
-/// Columns of a recorded frame before the joint positions: time, fell, base x y z, base
-/// quaternion x y z w.
-const FRAME_HEAD: usize = 9;
 
 /// The fall check's per-target table and its recorded frames.
 type TableAndFrames<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
@@ -39,60 +32,16 @@ pub fn fall_check<'py>(
     record_times: Vec<f64>,
 ) -> PyResult<TableAndFrames<'py>> {
     guard(|| {
-        if let Some(bad) = record_times.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
-            return Err(InvalidInputError::new_err(format!(
-                "record_times: expected finite times ≥ 0 s, got {bad}"
-            )));
-        }
         let start: Vec<f64> = start.as_array().iter().copied().collect();
         let targets = points("targets", &targets)?;
-        if targets.nrows() != start.len() {
-            return Err(InvalidInputError::new_err(format!(
-                "targets: expected shape (M, {}), got ({}, {})",
-                start.len(),
-                targets.ncols(),
-                targets.nrows()
-            )));
-        }
-        let rows: Vec<Vec<f64>> = targets.column_iter().map(|c| c.iter().copied().collect()).collect();
         let task = &task.inner;
-        let config = FallCheckConfig::for_task(task, hold).map_err(sim_to_py)?;
-        let world = task.world_config();
-        let dt = world.physics.dt;
-        let mut pending: Vec<f64> = record_times.iter().map(|t| (t / dt).round()).collect();
-        pending.sort_by(|a, b| b.total_cmp(a));
-        let mut frames: Vec<f64> = Vec::new();
-        let reports = py
-            .detach(|| {
-                let mut sim = World::new(task.model().clone(), world)?;
-                run_fall_check_observed(&mut sim, &start, &rows, &config, |sim, fell| {
-                    let done = (sim.time() / dt).round();
-                    while pending.last().is_some_and(|&step| done >= step) {
-                        pending.pop();
-                        let base = sim.base_pose();
-                        frames.extend([sim.time(), f64::from(u8::from(fell))]);
-                        frames.extend(base.translation.vector.iter());
-                        frames.extend(base.rotation.coords.iter());
-                        frames.extend(sim.joint_positions());
-                    }
-                })
-            })
+        let (reports, frames) = py
+            .detach(|| run_task_fall_check(task, &start, &targets, hold, &record_times))
             .map_err(sim_to_py)?;
-        let mut out = DMatrix::zeros(COLUMNS, reports.len());
-        for (j, r) in reports.iter().enumerate() {
-            let row = [
-                f64::from(u8::from(r.fell)),
-                r.min_margin,
-                r.final_margin,
-                r.grip_error,
-                r.max_grip_error,
-                r.status.base_height,
-                r.fall_time.unwrap_or(f64::NAN),
-            ];
-            out.column_mut(j).copy_from_slice(&row);
-        }
+        let table = reports.iter().flat_map(|r| r.row()).collect();
+        let table = DMatrix::from_vec(REPORT_COLUMNS.len(), reports.len(), table);
         let width = FRAME_HEAD + start.len();
         let frames = DMatrix::from_vec(width, frames.len() / width, frames);
-        Ok((to_points(py, out)?, to_points(py, frames)?))
+        Ok((to_points(py, table)?, to_points(py, frames)?))
     })
 }

@@ -6,7 +6,7 @@ use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use crate::convert::{fixed, points, to_points, to_vector};
-use crate::errors::{InvalidInputError, guard, to_py};
+use crate::errors::{guard, to_py};
 
 /// Means (M, p) and variances (M,) as NumPy arrays.
 type MeansVariances<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<f64>>);
@@ -106,17 +106,7 @@ impl PyGpMap {
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64)> {
         guard(|| {
             let x: Vec<f64> = x.as_array().iter().copied().collect();
-            if x.len() != self.inner.input_dim() {
-                return Err(InvalidInputError::new_err(format!(
-                    "x: expected shape ({},), got ({},)",
-                    self.inner.input_dim(),
-                    x.len()
-                )));
-            }
-            latent_core::error::check_finite("x", &x).map_err(to_py)?;
-            let mut mean = vec![0.0; self.inner.output_dim()];
-            let variance = self.inner.predict_into(&x, &mut mean, &mut self.inner.scratch());
-            latent_core::gp::check_prediction(&mean).map_err(to_py)?;
+            let (mean, variance) = self.inner.predict_one(&x).map_err(to_py)?;
             Ok((PyArray1::from_vec(py, mean), variance))
         })
     }

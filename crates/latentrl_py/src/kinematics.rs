@@ -8,56 +8,45 @@ use pyo3::prelude::*;
 use crate::convert::{points, to_points};
 use crate::errors::{InvalidInputError, guard, sim_to_py};
 
-/// `(N, 4)` array → flat row-major values, or InvalidInputError naming `name`.
-fn rows4(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<DMatrix<f64>> {
-    let matrix = points(name, array)?;
-    if matrix.nrows() != 4 {
-        return Err(InvalidInputError::new_err(format!(
-            "{name}: expected shape (N, 4), got ({}, {})",
-            matrix.ncols(),
-            matrix.nrows()
-        )));
-    }
-    Ok(matrix)
+/// `f` of the PlanarArms over the rows of `array` `(N, 4)` (named `name` in errors), as `(N, 4)`.
+fn batch<'py>(
+    py: Python<'py>,
+    name: &str,
+    array: &PyReadonlyArray2<'py, f64>,
+    f: fn(&PlanarArms, &[f64]) -> ::sim::error::Result<Vec<f64>>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    guard(|| {
+        let matrix = points(name, array)?;
+        if matrix.nrows() != 4 {
+            return Err(InvalidInputError::new_err(format!(
+                "{name}: expected shape (N, 4), got ({}, {})",
+                matrix.ncols(),
+                matrix.nrows()
+            )));
+        }
+        let out = py
+            .detach(|| f(&PlanarArms::default(), matrix.as_slice()))
+            .map_err(sim_to_py)?;
+        to_points(py, DMatrix::from_vec(4, matrix.ncols(), out))
+    })
 }
 
 /// Hands `(N, 4)` `[x_L, y_L, x_R, y_R]` of postures `(N, 4)` `[q1_L, q2_L, q1_R, q2_R]`
 /// (default geometry: shoulders (±0.15, 0), links 0.3 + 0.3 m).
 #[pyfunction]
 pub fn arms_fk<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    guard(|| {
-        let postures = rows4("postures", &postures)?;
-        let n = postures.ncols();
-        let hands = py
-            .detach(|| PlanarArms::default().forward_batch(postures.as_slice()))
-            .map_err(sim_to_py)?;
-        to_points(py, DMatrix::from_vec(4, n, hands))
-    })
+    batch(py, "postures", &postures, PlanarArms::forward_batch)
 }
 
 /// Elbows `(N, 4)` `[x_L, y_L, x_R, y_R]` of postures `(N, 4)` (for drawing).
 #[pyfunction]
 pub fn arms_elbows<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    guard(|| {
-        let postures = rows4("postures", &postures)?;
-        let n = postures.ncols();
-        let elbows = py
-            .detach(|| PlanarArms::default().elbows_batch(postures.as_slice()))
-            .map_err(sim_to_py)?;
-        to_points(py, DMatrix::from_vec(4, n, elbows))
-    })
+    batch(py, "postures", &postures, PlanarArms::elbows_batch)
 }
 
 /// Postures `(N, 4)` (elbows outward, shoulder angles continuous in front of the body) that
 /// put the hands at `hands` `(N, 4)`; an unreachable row raises InvalidInputError.
 #[pyfunction]
 pub fn arms_ik<'py>(py: Python<'py>, hands: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    guard(|| {
-        let hands = rows4("hands", &hands)?;
-        let n = hands.ncols();
-        let postures = py
-            .detach(|| PlanarArms::default().inverse_batch(hands.as_slice()))
-            .map_err(sim_to_py)?;
-        to_points(py, DMatrix::from_vec(4, n, postures))
-    })
+    batch(py, "hands", &hands, PlanarArms::inverse_batch)
 }

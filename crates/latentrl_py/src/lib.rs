@@ -19,7 +19,7 @@ use pyo3::prelude::*;
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     m.add("MAX_GP_POINTS", latent_core::gp::MAX_GP_POINTS)?;
-    m.add("MAX_EPISODES", runner::MAX_EPISODES)?;
+    m.add("MAX_EPISODES", latent_core::trials::MAX_EPISODES)?;
     m.add_class::<gp::PyGpMap>()?;
     m.add_class::<projection::PyProjection>()?;
     m.add_class::<world::PySim>()?;

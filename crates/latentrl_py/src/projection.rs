@@ -9,6 +9,9 @@ use crate::convert::{points, to_points, type_name};
 use crate::errors::{InvalidInputError, guard, to_py};
 use crate::gp::PyGpMap;
 
+/// The core's defaults of the keyword arguments.
+const DEFAULT: ProjectionConfig = ProjectionConfig::DEFAULT;
+
 /// The iterative-projection encoder posture → latent of a GPLVM decoder (docs/encoders.md).
 #[pyclass(name = "Projection", module = "latentrl._native", frozen)]
 pub struct PyProjection {
@@ -22,7 +25,7 @@ impl PyProjection {
     /// with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`;
     /// `tracking`: after a move, search from the commanded latent point (docs/encoders.md).
     #[new]
-    #[pyo3(signature = (decoder, postures, *, max_iter = 200, margin = 0.5, tracking = false))]
+    #[pyo3(signature = (decoder, postures, *, max_iter = DEFAULT.max_iter, margin = DEFAULT.margin, tracking = false))]
     fn new(
         py: Python<'_>,
         decoder: &Bound<'_, PyGpMap>,

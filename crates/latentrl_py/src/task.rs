@@ -4,14 +4,9 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use ::sim::task::survey::{LearnerGrid, survey};
-use ::sim::task::{
-    ConstraintConfig, FallConfig, FloorConfig, ObstacleConfig, Task, TaskConfig, TaskPlant, WaypointConfig,
-};
-use ::sim::world::JointServo;
-use latent_core::params::Kind;
-use latent_core::trials::LatentSpace;
-use latent_core::{ActionRule, EndReason, Learner, Phase, Plant, trial_rng};
+use ::sim::task::survey::{DEFAULT_MAX_POINTS, LearnerGrid, survey};
+use ::sim::task::{SchemaTable, Task, TaskConfig, TaskPlant, TaskTrials};
+use latent_core::{EndReason, LatentPolicy, Plant, trial_rng};
 use nalgebra::DMatrix;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -20,9 +15,7 @@ use pyo3::types::{PyDict, PyList};
 use crate::convert::{config_from, config_to, points, to_points};
 use crate::errors::{guard, sim_to_py, to_py};
 use crate::projection::EncoderObject;
-use crate::runner::{
-    RunArgs, check_recording, episodes_in, gp_map, invalid, latent_args, pack_results, run_with_polling,
-};
+use crate::runner::{RunArguments, invalid, latent_args, pack_results, run_with_polling};
 
 /// `classify`'s result: one code per posture and the effector positions.
 type CodesEffectorsTargets<'py> = (
@@ -107,7 +100,7 @@ impl PyTask {
     }
 
     /// Every collision shape as a dict (`urdf_info`'s shapes), to draw the robot.
-    fn collision_shapes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+    fn collision_shapes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let model = self.inner.model();
         crate::urdf::shape_list(py, &model.collision_shapes(), &model.link_names())
     }
@@ -232,31 +225,15 @@ impl PyTaskPlant {
     ) -> PyResult<CodesEffectorsTargets<'py>> {
         guard(|| {
             let postures = points("postures", &postures)?;
-            let d = self.inner.posture_dim();
-            if postures.nrows() != d {
-                return Err(invalid(format!(
-                    "postures: expected shape (M, {d}), got ({}, {})",
-                    postures.ncols(),
-                    postures.nrows()
-                )));
-            }
             let inner = &mut self.inner;
-            let (codes, effectors, targets) = py.detach(|| {
-                let mut codes = Vec::with_capacity(postures.ncols());
-                let (mut effectors, mut targets) = (Vec::new(), Vec::new());
-                for q in postures.column_iter() {
-                    let q: Vec<f64> = q.iter().copied().collect();
-                    codes.push(inner.reset(&q).map_or(0, |e| e.code() as i8));
-                    effectors.extend_from_slice(inner.effectors());
-                    targets.extend(inner.target_position());
-                }
-                (codes, effectors, targets)
-            });
+            let c = py.detach(|| inner.classify(&postures)).map_err(sim_to_py)?;
             let e = self.inner.effectors().len();
-            let effectors = DMatrix::from_vec(e, codes.len(), effectors);
-            let targets = DMatrix::from_vec(e, codes.len(), targets);
+            let (effectors, targets) = (
+                DMatrix::from_vec(e, c.codes.len(), c.effectors),
+                DMatrix::from_vec(e, c.codes.len(), c.targets),
+            );
             Ok((
-                PyArray1::from_vec(py, codes),
+                PyArray1::from_vec(py, c.codes),
                 to_points(py, effectors)?,
                 to_points(py, targets)?,
             ))
@@ -304,18 +281,8 @@ impl PyTaskPlant {
     /// World poses (L, 7) of every URDF link (position, quaternion x, y, z, w), in the order of
     /// `Task.link_names`; NaN for a link without a body.
     fn link_poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let poses = self.inner.world().link_poses();
-        let mut out = Vec::with_capacity(7 * poses.len());
-        for pose in &poses {
-            match pose {
-                Some(p) => {
-                    out.extend(p.translation.vector.iter());
-                    out.extend(p.rotation.coords.iter());
-                }
-                None => out.extend([f64::NAN; 7]),
-            }
-        }
-        to_points(py, DMatrix::from_vec(7, poses.len(), out))
+        let rows = self.inner.world().link_pose_rows();
+        to_points(py, DMatrix::from_vec(7, rows.len() / 7, rows))
     }
 
     /// Each constraint's error now (distance: signed m; offset: m; orientation: rad; plane: m
@@ -339,12 +306,9 @@ impl PyTaskPlant {
         joints: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         guard(|| {
-            let b = crate::convert::fixed::<7>("base", &base)?;
-            let rotation = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(b[6], b[3], b[4], b[5]));
-            let pose = nalgebra::Isometry3::from_parts(nalgebra::Translation3::new(b[0], b[1], b[2]), rotation);
-            self.inner
-                .place(&joints.as_array().to_vec(), &pose)
-                .map_err(sim_to_py)?;
+            let base = crate::convert::fixed::<7>("base", &base)?;
+            let joints = joints.as_array().to_vec();
+            self.inner.place_row(&joints, &base).map_err(sim_to_py)?;
             self.link_poses(py)
         })
     }
@@ -415,50 +379,28 @@ pub fn run_task_trials<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         #[rustfmt::skip]
-        let mut run = RunArgs { n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
-                                record_test_episodes, return_weights, progress }.check()?;
-        if let Some(name) = rollout {
-            let action = ActionRule::from_name(name)
-                .ok_or_else(|| invalid(format!("rollout must be one of {}, got {name:?}", ActionRule::kind())))?;
-            run.options.phase = Phase::Rollout { action, test_starts };
-        }
-        let task = Arc::clone(&task.inner);
+        let (options, progress) = RunArguments { n_trials, episodes, base_seed, first_trial, record_episodes,
+            test_episodes, record_test_episodes, return_weights, progress }
+            .check(rollout.map(|name| (name.to_string(), test_starts)))?;
         let demos = rows("demos", demos)?;
         let encoder = EncoderObject::extract("encoder", &encoder)?;
-        let decoder = Some(decoder);
-        let maps = latent_args(
-            gp_map("decoder", &decoder)?,
-            Some(encoder.get()),
-            Some(latent_low),
-            Some(latent_high),
-            "",
-        )?;
-        let latent = LatentSpace {
-            decoder: maps.decoder,
-            encoder: maps.encoder,
-            low: &maps.low,
-            high: &maps.high,
-        };
-        let config = &task.config().learner;
-        let rules = task.episode_rules();
-        // One plant and the learner up front: a bad task, demos or maps fail before any trial.
-        let probe = TaskPlant::new(Arc::clone(&task), demos.as_deref()).map_err(sim_to_py)?;
-        let mut template = Learner::new(config, rules, latent.low, latent.high).map_err(to_py)?;
-        template
-            .check_space(&latent.space(), probe.posture_dim())
-            .map_err(to_py)?;
-        drop(probe);
-        if let Some(w) = &weights {
-            template.set_weights(&w.as_array().to_vec()).map_err(to_py)?;
-        }
-        let options = &run.options;
-        check_recording(options, rules.max_steps, task.row_len())?;
-        let make_plant = |_| TaskPlant::new(Arc::clone(&task), demos.as_deref());
-        let results = run_with_polling(py, episodes_in(options), run.progress.as_ref(), |cancel, done| {
-            let make = |trial| make_plant(trial).map_err(|e| latent_core::CoreError::Plant { reason: e.to_string() });
-            latent_core::trials::run_trials(&template, &latent.space(), make, options, cancel, done).map_err(to_py)
+        let args = latent_args(Some(&decoder), Some(&encoder), Some(latent_low), Some(latent_high))?;
+        let latent = args.check("").map_err(to_py)?;
+        let weights = weights.map(|w| w.as_array().to_vec());
+        let task = Arc::clone(&task.inner);
+        let trials = TaskTrials::new(
+            Arc::clone(&task),
+            demos.as_deref(),
+            &latent,
+            weights.as_deref(),
+            options,
+        )
+        .map_err(sim_to_py)?;
+        let total = trials.options.total_episodes();
+        let results = run_with_polling(py, total, progress.as_ref(), |cancel, done| {
+            trials.run(cancel, done).map_err(sim_to_py)
         })?;
-        let out = pack_results(py, &results, &template, options, task.row_len())?;
+        let out = pack_results(py, &results, &trials.template, &trials.options, task.row_len())?;
         out.set_item("task", config_to(py, task.config())?)?;
         Ok(out)
     })
@@ -471,7 +413,7 @@ pub fn run_task_trials<'py>(
 /// (M, 3E), moves (M,): fewest learner moves to the target region, -1 for none; with `physics`
 /// each move also run from rest through the physics: blocked (M·A,) and moves_in_physics (M,)}.
 #[pyfunction]
-#[pyo3(signature = (task, *, decoder, latent_low, latent_high, demos = None, max_points = 20_000, physics = false, progress = None))]
+#[pyo3(signature = (task, *, decoder, latent_low, latent_high, demos = None, max_points = DEFAULT_MAX_POINTS, physics = false, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn latent_survey<'py>(
     py: Python<'py>,
@@ -485,31 +427,20 @@ pub fn latent_survey<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
-        let decoder = Some(decoder);
-        let maps = latent_args(
-            gp_map("decoder", &decoder)?,
-            Some(&()),
-            Some(latent_low),
-            Some(latent_high),
-            "",
-        )?;
+        let args = latent_args(Some(&decoder), None, Some(latent_low), Some(latent_high))?;
+        let (decoder, low, high) = args.check_box("").map_err(to_py)?;
         let demos = rows("demos", demos)?;
         let task = Arc::clone(&task.inner);
-        TaskPlant::new(Arc::clone(&task), demos.as_deref()).map_err(sim_to_py)?;
-        let at = LearnerGrid::new(&task, &maps.low, &maps.high, max_points).map_err(sim_to_py)?;
+        let at = LearnerGrid::for_survey(&task, demos.as_deref(), &low, &high, max_points).map_err(sim_to_py)?;
         let s = run_with_polling(py, at.grid.len(), progress.as_ref(), |cancel, done| {
-            survey(&task, demos.as_deref(), maps.decoder, &at, physics, cancel, done).map_err(sim_to_py)
+            survey(&task, demos.as_deref(), decoder, &at, physics, cancel, done).map_err(sim_to_py)
         })?;
         let out = PyDict::new(py);
-        let (m, d) = (s.grid.len(), maps.low.len());
-        let mut points = vec![0.0; m * d];
-        for (i, p) in points.chunks_exact_mut(d).enumerate() {
-            s.grid.point(i, p);
-        }
+        let (m, d) = (s.grid.len(), low.len());
         out.set_item("shape", s.grid.shape().to_vec())?;
         out.set_item("stride", s.grid.stride())?;
         out.set_item("spacing", s.grid.spacing().to_vec())?;
-        out.set_item("points", to_points(py, DMatrix::from_vec(d, m, points))?)?;
+        out.set_item("points", to_points(py, DMatrix::from_vec(d, m, s.grid.points()))?)?;
         out.set_item("codes", PyArray1::from_vec(py, s.codes))?;
         out.set_item("reward", PyArray1::from_vec(py, s.reward))?;
         out.set_item("distance", PyArray1::from_vec(py, s.distance))?;
@@ -547,48 +478,28 @@ pub fn learner_values<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     guard(|| {
         let config: latent_core::LearnerConfig = config_from("learner", learner)?;
-        let mut l = Learner::new(&config, Default::default(), &low, &high).map_err(to_py)?;
-        if let Some(w) = &weights {
-            l.set_weights(&w.as_array().to_vec()).map_err(to_py)?;
-        }
+        let weights = weights.map(|w| w.as_array().to_vec());
+        let policy = LatentPolicy::new(&config, &low, &high, weights.as_deref()).map_err(to_py)?;
         let z = crate::convert::points("points", &points)?;
-        if z.nrows() != low.len() {
-            return Err(invalid(format!(
-                "points: expected shape (M, {}), got ({}, {})",
-                low.len(),
-                z.ncols(),
-                z.nrows()
-            )));
-        }
-        let values = py.detach(|| l.values(z.as_slice())).map_err(to_py)?;
+        let values = py.detach(|| policy.values(&z)).map_err(to_py)?;
         Ok(PyArray1::from_vec(py, values))
     })
 }
 
-/// `{key, doc, rule, kind, default}` of each key in `fields`, its default read from the tables
-/// of `defaults` (key prefix → default table as a dict; "" the top).
-fn schema_list<'py>(
-    py: Python<'py>,
-    fields: Vec<(String, latent_core::FieldInfo)>,
-    defaults: &Bound<'py, PyDict>,
-) -> PyResult<Bound<'py, PyList>> {
+/// Schema tables as a list of dicts `{key, doc, rule, kind, default}`, one per key.
+fn schema_list(py: Python<'_>, tables: Vec<SchemaTable>) -> PyResult<Bound<'_, PyList>> {
     let out = PyList::empty(py);
-    for (key, field) in fields {
-        let entry = PyDict::new(py);
-        entry.set_item("key", &key)?;
-        entry.set_item("doc", &field.doc)?;
-        entry.set_item("rule", field.rule.to_string())?;
-        entry.set_item("kind", &field.kind)?;
-        let table = key.rsplit_once('.').map_or("", |(t, _)| t);
-        let default = match defaults.get_item(table)? {
-            Some(d) => d.get_item(field.name).ok(),
-            None => defaults
-                .get_item("")?
-                .and_then(|top| table.split('.').try_fold(top, |d, k| d.get_item(k).ok()))
-                .and_then(|d| d.get_item(field.name).ok()),
-        };
-        entry.set_item("default", default)?;
-        out.append(entry)?;
+    for table in tables {
+        let defaults = config_to(py, &table.defaults)?;
+        for e in table.entries {
+            let entry = PyDict::new(py);
+            entry.set_item("key", e.key)?;
+            entry.set_item("doc", e.doc)?;
+            entry.set_item("rule", e.rule)?;
+            entry.set_item("kind", e.kind)?;
+            entry.set_item("default", defaults.get_item(e.name).ok())?;
+            out.append(entry)?;
+        }
     }
     Ok(out)
 }
@@ -596,39 +507,15 @@ fn schema_list<'py>(
 /// Every key of a task file as dicts `{key, doc, rule, kind, default}`, table by table: the
 /// source of docs/tasks.md and of the CLI's flags.
 #[pyfunction]
-pub fn task_schema<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-    guard(|| {
-        let defaults = PyDict::new(py);
-        defaults.set_item("", config_to(py, &TaskConfig::default())?)?;
-        defaults.set_item("floor", config_to(py, &FloorConfig::default())?)?;
-        defaults.set_item("servo.joints.NAME", config_to(py, &JointServo::default())?)?;
-        defaults.set_item("constraints[]", config_to(py, &ConstraintConfig::default())?)?;
-        defaults.set_item("obstacles[]", config_to(py, &ObstacleConfig::default())?)?;
-        defaults.set_item("waypoint", config_to(py, &WaypointConfig::default())?)?;
-        defaults.set_item("fall", config_to(py, &FallConfig::default())?)?;
-        schema_list(py, TaskConfig::schema(), &defaults)
-    })
+pub fn task_schema(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    guard(|| schema_list(py, TaskConfig::schema_tables()))
 }
 
 /// The keys of Experiment 1's configuration (`plant.*`: the bimanual toy, `learner.*`), as
 /// `task_schema`.
 #[pyfunction]
-pub fn bimanual_schema<'py>(py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-    use latent_core::Params;
-    guard(|| {
-        let defaults = PyDict::new(py);
-        defaults.set_item("plant", config_to(py, &::sim::BimanualConfig::default())?)?;
-        defaults.set_item("learner", config_to(py, &latent_core::LearnerConfig::default())?)?;
-        let prefixed = |prefix: &str, fields: Vec<latent_core::FieldInfo>| {
-            fields
-                .into_iter()
-                .map(|f| (format!("{prefix}.{}", f.name), f))
-                .collect::<Vec<_>>()
-        };
-        let mut fields = prefixed("plant", ::sim::BimanualConfig::fields());
-        fields.extend(prefixed("learner", latent_core::LearnerConfig::fields()));
-        schema_list(py, fields, &defaults)
-    })
+pub fn bimanual_schema(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
+    guard(|| schema_list(py, ::sim::bimanual::schema_tables()))
 }
 
 /// The end reasons by code: their names in results files (0 timeout … 6 success).
@@ -637,11 +524,12 @@ pub fn end_reasons() -> Vec<&'static str> {
     EndReason::ALL.iter().map(|e| e.name()).collect()
 }
 
-/// A trained latent policy: the learner's grid and weights over the latent box with the GPLVM's
-/// maps; it acts greedily (the action of the largest look-ahead value).
+/// A trained latent policy (`latent_core::LatentPolicy`): the learner's grid and weights over
+/// the latent box with the GPLVM's maps; it acts greedily (the action of the largest look-ahead
+/// value).
 #[pyclass(name = "LatentPolicy", module = "latentrl._native", frozen)]
 pub struct PyLatentPolicy {
-    learner: Learner,
+    policy: LatentPolicy,
     decoder: Py<crate::gp::PyGpMap>,
     encoder: EncoderObject,
 }
@@ -662,18 +550,11 @@ impl PyLatentPolicy {
         guard(|| {
             let encoder = EncoderObject::extract("encoder", encoder)?;
             let config: latent_core::LearnerConfig = config_from("learner", learner)?;
-            let mut l = Learner::new(&config, Default::default(), &low, &high).map_err(to_py)?;
-            l.set_weights(&weights.as_array().to_vec()).map_err(to_py)?;
-            let space = latent_core::StateSpace::Latent {
-                decoder: &decoder.get().inner,
-                encoder: encoder.get(),
-            };
-            l.check_space(&space, decoder.get().inner.output_dim()).map_err(to_py)?;
-            Ok(Self {
-                learner: l,
-                decoder: decoder.unbind(),
-                encoder,
-            })
+            let weights = weights.as_array().to_vec();
+            let policy = LatentPolicy::new(&config, &low, &high, Some(&weights)).map_err(to_py)?;
+            policy.check_maps(&decoder.get().inner, encoder.get()).map_err(to_py)?;
+            #[rustfmt::skip]
+            return Ok(Self { policy, decoder: decoder.unbind(), encoder });
         })
     }
 
@@ -690,26 +571,11 @@ impl PyLatentPolicy {
         Bound<'py, PyArray1<f64>>,
     )> {
         guard(|| {
+            let posture = posture.as_array().to_vec();
             let (decoder, encoder) = (&self.decoder.get().inner, self.encoder.get());
-            let x = posture.as_array().to_vec();
-            if x.len() != encoder.input_dim() {
-                return Err(invalid(format!(
-                    "posture: expected shape ({},), got ({},)",
-                    encoder.input_dim(),
-                    x.len()
-                )));
-            }
-            latent_core::error::check_finite("posture", &x).map_err(to_py)?;
-            let mut z = vec![0.0; encoder.output_dim()];
-            encoder.encode_into(&x, &mut z, &mut encoder.encode_scratch());
-            let next = self.learner.greedy_target(&z).map_err(to_py)?;
-            let mut target = vec![0.0; decoder.output_dim()];
-            decoder.mean_into(&next, &mut target, &mut decoder.scratch());
-            Ok((
-                PyArray1::from_vec(py, target),
-                PyArray1::from_vec(py, z),
-                PyArray1::from_vec(py, next),
-            ))
+            let a = self.policy.act(decoder, encoder, &posture).map_err(to_py)?;
+            let array = |v| PyArray1::from_vec(py, v);
+            Ok((array(a.target), array(a.z), array(a.next)))
         })
     }
 
@@ -717,18 +583,7 @@ impl PyLatentPolicy {
     fn values<'py>(&self, py: Python<'py>, points: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         guard(|| {
             let z = crate::convert::points("points", &points)?;
-            let dim = self.learner.grid().dim();
-            if z.nrows() != dim {
-                return Err(invalid(format!(
-                    "points: expected shape (M, {dim}), got ({}, {})",
-                    z.ncols(),
-                    z.nrows()
-                )));
-            }
-            Ok(PyArray1::from_vec(
-                py,
-                self.learner.values(z.as_slice()).map_err(to_py)?,
-            ))
+            Ok(PyArray1::from_vec(py, self.policy.values(&z).map_err(to_py)?))
         })
     }
 }

@@ -4,55 +4,16 @@
 use std::path::PathBuf;
 
 use ::sim::UrdfModel;
-use ::sim::urdf::{JointKind, LoadOptions, ShapeInfo};
+use ::sim::urdf::{LoadOptions, ShapeInfo, ShapeSummary};
 use numpy::PyReadonlyArray2;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
 
+use crate::convert::config_to;
 use crate::errors::{guard, sim_to_py};
 
-/// One shape as a dict `{link, kind, size, origin, file, hull}` (origin: position and
-/// quaternion x, y, z, w in the link's frame; file: a mesh's resolved path or None; hull:
-/// `{triangles, vertices, cached}` for a collision mesh, else None).
-pub fn shape_dict<'py>(py: Python<'py>, s: &ShapeInfo, links: &[&str]) -> PyResult<Bound<'py, PyDict>> {
-    let d = PyDict::new(py);
-    d.set_item("link", links[s.link])?;
-    d.set_item("kind", s.kind)?;
-    d.set_item("size", &s.size)?;
-    let t = s.origin.translation.vector;
-    let q = s.origin.rotation.coords;
-    d.set_item("origin", vec![t.x, t.y, t.z, q.x, q.y, q.z, q.w])?;
-    d.set_item("file", &s.file)?;
-    let hull = match s.hull {
-        Some((triangles, vertices, cached)) => {
-            let h = PyDict::new(py);
-            h.set_item("triangles", triangles)?;
-            h.set_item("vertices", vertices)?;
-            h.set_item("cached", cached)?;
-            Some(h)
-        }
-        None => None,
-    };
-    d.set_item("hull", hull)?;
-    d.set_item("points", &s.points)?;
-    Ok(d)
-}
-
-/// Shapes as a list of [`shape_dict`]s.
-pub fn shape_list<'py>(py: Python<'py>, shapes: &[ShapeInfo], links: &[&str]) -> PyResult<Bound<'py, PyList>> {
-    let out = PyList::empty(py);
-    for s in shapes {
-        out.append(shape_dict(py, s, links)?)?;
-    }
-    Ok(out)
-}
-
-fn kind_name(kind: JointKind) -> &'static str {
-    match kind {
-        JointKind::Revolute => "revolute",
-        JointKind::Continuous => "continuous",
-        JointKind::Prismatic => "prismatic",
-    }
+/// Shapes as a list of dicts `{link, kind, size, origin, file, hull, points}` (`sim::urdf::ShapeSummary`).
+pub fn shape_list<'py>(py: Python<'py>, shapes: &[ShapeInfo], links: &[&str]) -> PyResult<Bound<'py, PyAny>> {
+    config_to(py, &ShapeSummary::all(shapes, links))
 }
 
 /// Reads and checks a URDF file (meshes hulled, through the cache; inertias repaired with
@@ -62,48 +23,14 @@ fn kind_name(kind: JointKind) -> &'static str {
 /// offset}` or None), actuated joints first in URDF order, then the mimic ones.
 #[pyfunction]
 #[pyo3(signature = (path, *, balance_inertia = false))]
-pub fn urdf_info<'py>(py: Python<'py>, path: PathBuf, balance_inertia: bool) -> PyResult<Bound<'py, PyDict>> {
+pub fn urdf_info<'py>(py: Python<'py>, path: PathBuf, balance_inertia: bool) -> PyResult<Bound<'py, PyAny>> {
     guard(|| {
         let options = LoadOptions { balance_inertia };
         let cache = ::sim::urdf::cache::default_folder();
         let model = py
             .detach(|| UrdfModel::from_file_with_options(&path, cache.as_deref(), options))
             .map_err(sim_to_py)?;
-        let links = model.link_names();
-        let joints = PyList::empty(py);
-        let mimics = model.mimics().iter().map(|m| (&m.joint, Some(m)));
-        for (j, mimic) in model.joints().iter().map(|j| (j, None)).chain(mimics) {
-            let d = PyDict::new(py);
-            d.set_item("name", &j.name)?;
-            d.set_item("type", kind_name(j.kind))?;
-            d.set_item("lower", j.lower)?;
-            d.set_item("upper", j.upper)?;
-            d.set_item("effort", j.effort)?;
-            d.set_item("velocity", j.velocity)?;
-            d.set_item("damping", j.damping)?;
-            d.set_item("friction", j.friction)?;
-            let coupling = match mimic {
-                Some(m) => {
-                    let c = PyDict::new(py);
-                    c.set_item("leader", &model.joints()[m.leader].name)?;
-                    c.set_item("multiplier", m.multiplier)?;
-                    c.set_item("offset", m.offset)?;
-                    Some(c)
-                }
-                None => None,
-            };
-            d.set_item("mimic", coupling)?;
-            joints.append(d)?;
-        }
-        let out = PyDict::new(py);
-        out.set_item("name", model.name())?;
-        out.set_item("joints", joints)?;
-        out.set_item("links", &links)?;
-        out.set_item("collision", shape_list(py, &model.collision_shapes(), &links)?)?;
-        out.set_item("visual", shape_list(py, &model.visual_shapes(), &links)?)?;
-        out.set_item("total_mass", model.total_mass())?;
-        out.set_item("warnings", model.warnings())?;
-        Ok(out)
+        config_to(py, &model.summary())
     })
 }
 

@@ -1,18 +1,16 @@
 //! Binding of `sim::world`: a URDF robot in a rapier3d world with PD servos ([`World`]),
 //! driven from Python one RL step (or `n` physics steps) per call.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use ::sim::fall::reset_on_ground;
 use ::sim::urdf::LoadOptions;
-use ::sim::{
-    FallCriteria, Obstacle, ObstacleShape, PhysicsConfig, RootMode, ServoConfig, UrdfModel, World, WorldConfig,
-};
+use ::sim::{FallCriteria, Obstacle, ObstacleShape, RootMode, UrdfModel, World, WorldConfig};
 use nalgebra::Isometry3;
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
-use crate::convert::{config_from, fixed};
+use crate::convert::{config_or_default, fixed};
 use crate::errors::{InvalidInputError, guard, sim_to_py};
 
 /// A 1-D array of any length, copied into a `Vec` (the sim checks the length).
@@ -44,37 +42,19 @@ impl PySim {
         balance_inertia: bool,
     ) -> PyResult<Self> {
         guard(|| {
-            let root = match root {
-                "fixed" => RootMode::Fixed,
-                "floating" => RootMode::Floating,
-                other => {
-                    return Err(InvalidInputError::new_err(format!(
-                        "root: expected \"fixed\" or \"floating\", got {other:?}"
-                    )));
-                }
-            };
-            let physics: PhysicsConfig = physics.map_or(Ok(PhysicsConfig::default()), |p| config_from("physics", p))?;
-            let servo: ServoConfig = servo.map_or(Ok(ServoConfig::default()), |s| config_from("servo", s))?;
-            let config = WorldConfig {
-                root,
-                floor,
-                physics,
-                servo,
-            };
+            let root = RootMode::from_name(root).ok_or_else(|| {
+                InvalidInputError::new_err(format!("root: expected \"fixed\" or \"floating\", got {root:?}"))
+            })?;
+            #[rustfmt::skip]
+            let config = WorldConfig { root, floor, physics: config_or_default("physics", physics)?,
+                                       servo: config_or_default("servo", servo)? };
+            let path: PathBuf = urdf
+                .extract()
+                .map_err(|_| InvalidInputError::new_err("urdf: expected a path or the URDF XML as a str"))?;
             let options = LoadOptions { balance_inertia };
-            let cache = ::sim::urdf::cache::default_folder();
-            let model = match urdf.extract::<String>() {
-                Ok(text) if text.trim_start().starts_with('<') => {
-                    UrdfModel::parse_with_options(&text, "<string>", Path::new("."), cache.as_deref(), options)
-                }
-                _ => {
-                    let path: PathBuf = urdf
-                        .extract()
-                        .map_err(|_| InvalidInputError::new_err("urdf: expected a path or the URDF XML as a str"))?;
-                    py.detach(|| UrdfModel::from_file_with_options(path, cache.as_deref(), options))
-                }
-            }
-            .map_err(sim_to_py)?;
+            let model = py
+                .detach(|| UrdfModel::from_xml_or_file(&path, options))
+                .map_err(sim_to_py)?;
             let inner = py.detach(|| World::new(model, config)).map_err(sim_to_py)?;
             Ok(Self { inner })
         })
@@ -106,7 +86,7 @@ impl PySim {
     /// Teleports a floating robot to `posture` at rest standing on the floor: the base is
     /// placed so that link `sole` lies flat, its lowest corner `clearance` m above the ground
     /// (needs a `floor`).
-    #[pyo3(signature = (posture, sole, clearance = 5e-4))]
+    #[pyo3(signature = (posture, sole, clearance = ::sim::fall::GROUND_CLEARANCE))]
     fn reset_on_ground(&mut self, posture: PyReadonlyArray1<'_, f64>, sole: &str, clearance: f64) -> PyResult<()> {
         guard(|| {
             let ground =
@@ -126,7 +106,7 @@ impl PySim {
     /// The fall test now: `(fell, base_height, sole_tilt, ground_contact)`, fallen when the
     /// base origin is below `min_base_height` (m), a link of `soles` tilts more than
     /// `max_sole_tilt` (rad) or another link touches the floor (the first such link, else None).
-    #[pyo3(signature = (soles, *, min_base_height, max_sole_tilt = 20f64.to_radians()))]
+    #[pyo3(signature = (soles, *, min_base_height, max_sole_tilt = ::sim::fall::MAX_SOLE_TILT))]
     fn fall_status(
         &self,
         soles: Vec<String>,

@@ -162,14 +162,14 @@ fn arms_learner_step(c: &mut Criterion) {
     let latent = LatentSpace {
         decoder: &decoder,
         encoder: &encoder,
-        low: &[0.0, 0.0],
-        high: &[1.0, 1.0],
+        low: vec![0.0, 0.0],
+        high: vec![1.0, 1.0],
     };
     let task = task(2, 0.02);
     let mut plant = TaskPlant::new(Arc::clone(&task), None).expect("plant builds");
     let space = latent.space();
     let mut learner =
-        Learner::new(&task.config().learner, task.episode_rules(), latent.low, latent.high).expect("learner");
+        Learner::new(&task.config().learner, task.episode_rules(), &latent.low, &latent.high).expect("learner");
     let mut scratch = learner.scratch(&space, 4);
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     learner

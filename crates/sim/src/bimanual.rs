@@ -18,9 +18,9 @@ use std::sync::atomic::{AtomicBool, AtomicUsize};
 
 use latent_core::error::Result;
 use latent_core::params::{ParamError, Params, Rule};
-use latent_core::trials::{TrialOptions, TrialResult, run_trials};
+use latent_core::trials::{LatentSpace, TrialOptions, TrialResult, run_trials};
 use latent_core::{
-    Encode, EndReason, EpisodeRules, GpMap, Learner, LearnerConfig, Plant, StateSpace, StepOutcome, params,
+    CoreError, Encode, EndReason, EpisodeRules, GpMap, Learner, LearnerConfig, Plant, StateSpace, StepOutcome, params,
 };
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -222,6 +222,19 @@ pub enum BimanualLearner<'a> {
 }
 
 impl<'a> BimanualLearner<'a> {
+    /// The latent learner in `latent`, or the full-space learner without one.
+    pub fn new(latent: Option<&'a LatentSpace<'a>>) -> Self {
+        match latent {
+            Some(l) => Self::Latent {
+                decoder: l.decoder,
+                encoder: l.encoder,
+                low: &l.low,
+                high: &l.high,
+            },
+            None => Self::Full,
+        }
+    }
+
     /// The learner (box, actions, fresh weights) and its state space for `plant`.
     pub fn build(&self, plant: &BimanualConfig, config: &LearnerConfig) -> Result<(Learner, StateSpace<'a>)> {
         plant.validate()?;
@@ -265,6 +278,58 @@ pub fn run_bimanual_trials(
         cancel,
         done,
     )
+}
+
+/// Experiment 1's trials, checked before any runs: both configurations (their errors named
+/// `plant.*` and `learner.*`), the learner's grid and maps, the recorded paths' memory.
+#[derive(Debug)]
+pub struct BimanualTrials<'a> {
+    /// The toy's configuration.
+    pub plant: BimanualConfig,
+    /// The learner's configuration.
+    pub config: LearnerConfig,
+    learner: BimanualLearner<'a>,
+    /// The learner every trial starts from.
+    pub template: Learner,
+    /// What is run.
+    pub options: TrialOptions,
+}
+
+impl<'a> BimanualTrials<'a> {
+    /// The trials of `learner` (`config`) on the toy `plant` with `options`.
+    pub fn new(
+        plant: BimanualConfig,
+        config: LearnerConfig,
+        learner: BimanualLearner<'a>,
+        options: TrialOptions,
+    ) -> Result<Self> {
+        check_tables(&plant, &config)?;
+        let (template, _) = learner.build(&plant, &config)?;
+        options.check_recording(plant.max_steps, 4)?;
+        #[rustfmt::skip]
+        return Ok(Self { plant, config, learner, template, options });
+    }
+
+    /// Runs the trials ([`run_bimanual_trials`]).
+    pub fn run(&self, cancel: &AtomicBool, done: &AtomicUsize) -> Result<Vec<TrialResult>> {
+        run_bimanual_trials(&self.plant, &self.config, &self.learner, &self.options, cancel, done)
+    }
+}
+
+/// Both of Experiment 1's configurations checked, a broken rule named `plant.*` or `learner.*`.
+pub fn check_tables(plant: &BimanualConfig, learner: &LearnerConfig) -> Result<()> {
+    plant.check_fields("plant").map_err(CoreError::from)?;
+    learner.check_fields("learner").map_err(CoreError::from)
+}
+
+/// The keys of Experiment 1's configuration (`plant.*`: the toy, `learner.*`) with their docs,
+/// rules, types and defaults.
+pub fn schema_tables() -> Vec<crate::task::SchemaTable> {
+    use crate::task::{SchemaTable, TableDefaults};
+    vec![
+        SchemaTable::of::<BimanualConfig>("plant", TableDefaults::Plant(BimanualConfig::default())),
+        SchemaTable::of::<LearnerConfig>("learner", TableDefaults::Learner(LearnerConfig::default())),
+    ]
 }
 
 #[cfg(test)]

@@ -23,6 +23,13 @@ use crate::world::World;
 /// Sole corners up to this far (m) above the lowest sole corner count as touching.
 pub const SOLE_CONTACT_TOLERANCE: f64 = 2e-3;
 
+/// Height (m) above the floor of the lowest sole corner when a robot is put on the ground.
+pub const GROUND_CLEARANCE: f64 = 5e-4;
+
+/// The largest sole tilt (rad) before a robot counts as fallen, unless a task says otherwise:
+/// 20° (docs/method.md §Experiment 3).
+pub const MAX_SOLE_TILT: f64 = 20f64.to_radians();
+
 /// Thresholds of the fall test for a free-floating robot (docs/method.md §Experiment 3: a sole
 /// tilting more than 20°, a non-sole body touching the floor, or the base height halving).
 #[derive(Debug, Clone, PartialEq)]

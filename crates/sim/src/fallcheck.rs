@@ -6,7 +6,7 @@
 use latent_core::CoreError;
 
 use crate::error::{Result, SimError, check_finite};
-use crate::fall::{FallCriteria, FallStatus, reset_on_ground, support_margin};
+use crate::fall::{FallCriteria, FallStatus, GROUND_CLEARANCE, reset_on_ground, support_margin};
 use crate::task::{ConstraintKind, Task};
 use crate::world::World;
 
@@ -98,6 +98,81 @@ pub fn run_fall_check(
     run_fall_check_observed(sim, start, targets, config, |_, _| {})
 }
 
+/// The names of [`SegmentReport::row`]'s columns.
+pub const REPORT_COLUMNS: [&str; 7] = [
+    "fell",
+    "min_margin",
+    "final_margin",
+    "grip_error",
+    "max_grip_error",
+    "base_height",
+    "fall_time",
+];
+
+/// Columns of a recorded frame before the joint positions: time (s), fell (0/1), base
+/// position (m), base quaternion (x, y, z, w).
+pub const FRAME_HEAD: usize = 9;
+
+impl SegmentReport {
+    /// The report as numbers, in [`REPORT_COLUMNS`] order: fell (0/1), margins (m), grip
+    /// errors (m), base height (m), time of the fall (s; NaN while standing).
+    pub fn row(&self) -> [f64; 7] {
+        [
+            f64::from(u8::from(self.fell)),
+            self.min_margin,
+            self.final_margin,
+            self.grip_error,
+            self.max_grip_error,
+            self.status.base_height,
+            self.fall_time.unwrap_or(f64::NAN),
+        ]
+    }
+}
+
+/// The fall check of `task` ([`FallCheckConfig::for_task`]) in its world: stand at `start`
+/// (D,), hold each column of `targets` (D × M) for `hold` s. Returns the reports and the
+/// frames recorded at `record_times` (s), each at the first check at or after it:
+/// [`FRAME_HEAD`] values, then the joint positions, frame after frame.
+pub fn run_task_fall_check(
+    task: &Task,
+    start: &[f64],
+    targets: &nalgebra::DMatrix<f64>,
+    hold: f64,
+    record_times: &[f64],
+) -> Result<(Vec<SegmentReport>, Vec<f64>)> {
+    if let Some(bad) = record_times.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
+        return Err(CoreError::Argument(format!("record_times: expected finite times ≥ 0 s, got {bad}")).into());
+    }
+    if targets.nrows() != start.len() {
+        return Err(CoreError::Shape {
+            what: "targets",
+            expected: format!("(M, {})", start.len()),
+            got: format!("({}, {})", targets.ncols(), targets.nrows()),
+        }
+        .into());
+    }
+    let rows: Vec<Vec<f64>> = targets.column_iter().map(|c| c.iter().copied().collect()).collect();
+    let config = FallCheckConfig::for_task(task, hold)?;
+    let world = task.world_config();
+    let dt = world.physics.dt;
+    let mut pending: Vec<f64> = record_times.iter().map(|t| (t / dt).round()).collect();
+    pending.sort_by(|a, b| b.total_cmp(a));
+    let mut frames: Vec<f64> = Vec::new();
+    let mut sim = World::new(task.model().clone(), world)?;
+    let reports = run_fall_check_observed(&mut sim, start, &rows, &config, |sim, fell| {
+        let done = (sim.time() / dt).round();
+        while pending.last().is_some_and(|&step| done >= step) {
+            pending.pop();
+            let base = sim.base_pose();
+            frames.extend([sim.time(), f64::from(u8::from(fell))]);
+            frames.extend(base.translation.vector.iter());
+            frames.extend(base.rotation.coords.iter());
+            frames.extend(sim.joint_positions());
+        }
+    })?;
+    Ok((reports, frames))
+}
+
 /// [`run_fall_check`] that also calls `observe(sim, fell)` after the reset and after every
 /// check (every `config.check_every` physics steps; `sim.time()` is the time since the start),
 /// e.g. to record the robot's poses for a picture.
@@ -117,7 +192,7 @@ pub fn run_fall_check_observed(
         }));
     }
     let ground = sim.config.floor.unwrap_or(0.0);
-    reset_on_ground(sim, start, &config.soles[0], ground, 5e-4, None)?;
+    reset_on_ground(sim, start, &config.soles[0], ground, GROUND_CLEARANCE, None)?;
     let mut fall = config.fall.clone();
     if fall.min_base_height <= 0.0 {
         fall.min_base_height = ground + 0.5 * (sim.base_pose().translation.z - ground);

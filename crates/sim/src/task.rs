@@ -16,11 +16,13 @@ use crate::world::WorldConfig;
 mod config;
 mod plant;
 pub mod survey;
+pub mod trials;
 pub use config::{
     Axis, ConstraintConfig, ConstraintKind, EpisodeConfig, FallConfig, FloorConfig, ObstacleConfig, ObstacleTest,
-    RuleCheck, StartRule, TargetConfig, TaskConfig, TestStart, WaypointConfig,
+    RuleCheck, SchemaEntry, SchemaTable, StartRule, TableDefaults, TargetConfig, TaskConfig, TestStart, WaypointConfig,
 };
-pub use plant::TaskPlant;
+pub use plant::{Classified, TaskPlant};
+pub use trials::TaskTrials;
 
 /// Largest task file read (bytes): a task is a page of text. A FIFO, a device or a directory
 /// given as a task file is refused before it is read ([`crate::files`]).

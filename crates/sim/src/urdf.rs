@@ -36,10 +36,12 @@ mod lint;
 pub mod mesh;
 mod mesh_counts;
 mod repair;
+mod summary;
 pub use check::{MAX_URDF_BYTES, MAX_URDF_DEPTH, MAX_URDF_LINKS};
 use check::{check_joint_types, check_robot, check_size, inertia_problem, inertia_problems};
 pub(crate) use insert::JointSlot;
 use mesh::MeshHull;
+pub use summary::{HullSummary, JointSummary, MimicSummary, ShapeSummary, UrdfSummary};
 
 choice! {
     /// How the root link of the robot is attached to the world.
@@ -74,7 +76,8 @@ pub struct LoadOptions {
 pub const MIMIC_TOLERANCE: f64 = 1e-3;
 
 /// Kind of an actuated (one-DoF) joint.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum JointKind {
     /// Hinge with position limits; the coordinate is an angle in radians.
     Revolute,
@@ -84,14 +87,17 @@ pub enum JointKind {
     Prismatic,
 }
 
-/// One actuated joint as written in the URDF.
-#[derive(Debug, Clone, PartialEq)]
+/// One actuated joint as written in the URDF (serialised without its child link, its kind as
+/// `type`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct JointInfo {
     /// Joint name.
     pub name: String,
     /// Joint kind.
+    #[serde(rename = "type")]
     pub kind: JointKind,
     /// Name of the link the joint moves.
+    #[serde(skip)]
     pub child_link: String,
     /// Lower position limit (−∞ for continuous joints).
     pub lower: f64,
@@ -229,6 +235,19 @@ impl UrdfModel {
     /// malformed before it is parsed.
     pub fn parse_with(xml: &str, origin: &str, folder: &Path, cache: Option<&Path>) -> Result<Self> {
         Self::parse_with_options(xml, origin, folder, cache, LoadOptions::default())
+    }
+
+    /// A robot from `source`: the URDF XML itself if it starts with `<` (after white space;
+    /// mesh paths relative to the working folder), else the path of a URDF file; with the
+    /// default hull cache and the repairs of `options`.
+    pub fn from_xml_or_file(source: &Path, options: LoadOptions) -> Result<Self> {
+        let cache = cache::default_folder();
+        match source.to_str() {
+            Some(text) if text.trim_start().starts_with('<') => {
+                Self::parse_with_options(text, "<string>", Path::new("."), cache.as_deref(), options)
+            }
+            _ => Self::from_file_with_options(source, cache.as_deref(), options),
+        }
     }
 
     /// [`UrdfModel::parse_with`] with the repairs of `options`. Before the XML parser, a scan of

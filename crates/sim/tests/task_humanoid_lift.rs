@@ -6,10 +6,11 @@ mod common;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
-use latent_core::trials::{LatentSpace, TrialOptions, TrialResult, run_latent_trials};
+use latent_core::trials::{LatentSpace, TrialOptions, TrialResult};
 use latent_core::{EndReason, GpMap, LearnerConfig, Plant, SeKernel};
 use nalgebra::DMatrix;
 use rand::SeedableRng;
+use sim::task::TaskTrials;
 use sim::{Task, TaskPlant};
 
 /// Steps `n` RL steps along the joint-space line `from → to`; returns the outcomes until
@@ -172,17 +173,20 @@ fn demo_maps() -> (GpMap, GpMap) {
 }
 
 fn run(threads: usize, task: &std::sync::Arc<Task>, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
-    let config = LearnerConfig {
+    // The learner's step and the episode length of this test, through the task's own keys.
+    let mut config = task.config().clone();
+    config.learner = LearnerConfig {
         step: 0.5,
-        ..task.config().learner.clone()
+        ..config.learner
     };
-    let mut rules = task.episode_rules();
-    rules.max_steps = 8;
+    config.episode.max_steps = 8;
+    let task =
+        std::sync::Arc::new(Task::from_config(config, std::path::Path::new(common::TASKS), task.origin()).unwrap());
     let latent = LatentSpace {
         decoder,
         encoder,
-        low: &[-1.2, -0.1],
-        high: &[1.2, 1.1],
+        low: vec![-1.2, -0.1],
+        high: vec![1.2, 1.1],
     };
     let options = TrialOptions {
         n_trials: 2,
@@ -194,20 +198,8 @@ fn run(threads: usize, task: &std::sync::Arc<Task>, decoder: &GpMap, encoder: &G
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let done = AtomicUsize::new(0);
     let demos = common::lift_demos();
-    let results = pool
-        .install(|| {
-            let cancel = AtomicBool::new(false);
-            run_latent_trials(
-                |_| TaskPlant::new(task.clone(), Some(&demos)),
-                &config,
-                rules,
-                &latent,
-                &options,
-                &cancel,
-                &done,
-            )
-        })
-        .unwrap();
+    let trials = TaskTrials::new(task, Some(&demos), &latent, None, options).unwrap();
+    let results = pool.install(|| trials.run(&AtomicBool::new(false), &done)).unwrap();
     assert_eq!(done.into_inner(), 2 * 3);
     results
 }

@@ -5,9 +5,10 @@ mod common;
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
-use latent_core::trials::{LatentSpace, TrialOptions, TrialResult, run_latent_trials};
+use latent_core::trials::{LatentSpace, TrialOptions, TrialResult};
 use latent_core::{EndReason, GpMap, LearnerConfig, Plant, SeKernel, StartMode};
 use nalgebra::DMatrix;
+use sim::task::TaskTrials;
 use sim::{PlanarArms, RuleCheck, Task, TaskPlant};
 
 /// The posture (elbows outward) with the left hand at `(x, y)` and the right hand 0.1 m to its right.
@@ -218,18 +219,21 @@ fn gap_maps() -> (GpMap, GpMap) {
 }
 
 fn run(threads: usize, task: &std::sync::Arc<Task>, decoder: &GpMap, encoder: &GpMap) -> Vec<TrialResult> {
-    let config = LearnerConfig {
+    // The learner's step and the episode length of this test, through the task's own keys.
+    let mut config = task.config().clone();
+    config.learner = LearnerConfig {
         step: 0.5,
-        ..task.config().learner.clone()
+        ..config.learner
     };
-    let mut rules = task.episode_rules();
-    rules.max_steps = 60;
-    assert_eq!(rules.start, StartMode::Uniform);
+    config.episode.max_steps = 60;
+    let task =
+        std::sync::Arc::new(Task::from_config(config, std::path::Path::new(common::TASKS), task.origin()).unwrap());
+    assert_eq!(task.episode_rules().start, StartMode::Uniform);
     let latent = LatentSpace {
         decoder,
         encoder,
-        low: &[0.0, 0.0],
-        high: &[1.0, 1.0],
+        low: vec![0.0, 0.0],
+        high: vec![1.0, 1.0],
     };
     let options = TrialOptions {
         n_trials: 2,
@@ -242,19 +246,8 @@ fn run(threads: usize, task: &std::sync::Arc<Task>, decoder: &GpMap, encoder: &G
     };
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let done = AtomicUsize::new(0);
-    let results = pool
-        .install(|| {
-            run_latent_trials(
-                |_| TaskPlant::new(task.clone(), None),
-                &config,
-                rules,
-                &latent,
-                &options,
-                &AtomicBool::new(false),
-                &done,
-            )
-        })
-        .unwrap();
+    let trials = TaskTrials::new(task, None, &latent, None, options).unwrap();
+    let results = pool.install(|| trials.run(&AtomicBool::new(false), &done)).unwrap();
     assert_eq!(done.into_inner(), 2 * (6 + 4));
     results
 }

@@ -318,7 +318,7 @@ params! {
         /// collision shapes make the support polygon).
         soles: Vec<String> = Vec::new() => Rule::NonEmpty,
         /// A sole leaning more than this from the vertical is a fall (rad; Experiment 3: 20°).
-        max_tilt: f64 = 20f64.to_radians() => Rule::open_closed(0.0, std::f64::consts::PI),
+        max_tilt: f64 = crate::fall::MAX_SOLE_TILT => Rule::open_closed(0.0, std::f64::consts::PI),
         /// The base below this share of its height above the floor at the reset is a fall
         /// (Experiment 3: half).
         base_height_fraction: f64 = 0.5 => Rule::open(0.0, 1.0),
@@ -450,5 +450,117 @@ impl TaskConfig {
         add::<EpisodeConfig>("episode", &mut out);
         add::<LearnerConfig>("learner", &mut out);
         out
+    }
+
+    /// Every key of a task file with its doc, rule and type, table by table with the table's
+    /// defaults: the source of docs/tasks.md and of the CLI's flags. A key's default is its
+    /// table's: the optional and repeated tables' own, the others' as in the default task.
+    pub fn schema_tables() -> Vec<SchemaTable> {
+        let top = TaskConfig::default();
+        let defaults = |prefix: &str| match prefix {
+            "floor" => TableDefaults::Floor(FloorConfig::default()),
+            "servo" => TableDefaults::Servo(top.servo.clone()),
+            "servo.joints.NAME" => TableDefaults::JointServo(crate::world::JointServo::default()),
+            "physics" => TableDefaults::Physics(top.physics.clone()),
+            "target" => TableDefaults::Target(top.target.clone()),
+            "constraints[]" => TableDefaults::Constraint(ConstraintConfig::default()),
+            "obstacles[]" => TableDefaults::Obstacle(ObstacleConfig::default()),
+            "waypoint" => TableDefaults::Waypoint(WaypointConfig::default()),
+            "fall" => TableDefaults::Fall(FallConfig::default()),
+            "episode" => TableDefaults::Episode(top.episode.clone()),
+            "learner" => TableDefaults::Learner(top.learner.clone()),
+            _ => TableDefaults::Task(Box::new(top.clone())),
+        };
+        let mut tables: Vec<SchemaTable> = Vec::new();
+        for (key, field) in TaskConfig::schema() {
+            let prefix = key.rsplit_once('.').map_or("", |(t, _)| t);
+            if tables.last().is_none_or(|t| t.prefix != prefix) {
+                tables.push(SchemaTable::new(prefix, defaults(prefix), Vec::new()));
+            }
+            tables
+                .last_mut()
+                .expect("pushed")
+                .entries
+                .push(SchemaEntry::new(key, field));
+        }
+        tables
+    }
+}
+
+/// The defaults of one table of settings, serialised as the table itself.
+#[derive(Debug, Clone, serde::Serialize)]
+#[serde(untagged)]
+#[allow(missing_docs)]
+pub enum TableDefaults {
+    Task(Box<TaskConfig>),
+    Floor(FloorConfig),
+    Servo(ServoConfig),
+    JointServo(crate::world::JointServo),
+    Physics(PhysicsConfig),
+    Target(TargetConfig),
+    Constraint(ConstraintConfig),
+    Obstacle(ObstacleConfig),
+    Waypoint(WaypointConfig),
+    Fall(FallConfig),
+    Episode(EpisodeConfig),
+    Learner(LearnerConfig),
+    Plant(crate::BimanualConfig),
+}
+
+/// One table of settings: its keys and their defaults.
+#[derive(Debug, Clone)]
+pub struct SchemaTable {
+    /// The table's key path (`""` for the top, `constraints[]` for a repeated table).
+    pub prefix: String,
+    /// The table's defaults; a key's default is the value of its `name` here (none if absent).
+    pub defaults: TableDefaults,
+    /// Its keys, in declaration order.
+    pub entries: Vec<SchemaEntry>,
+}
+
+impl SchemaTable {
+    /// The table at `prefix` with `defaults` and `entries`.
+    pub fn new(prefix: &str, defaults: TableDefaults, entries: Vec<SchemaEntry>) -> Self {
+        Self {
+            prefix: prefix.to_string(),
+            defaults,
+            entries,
+        }
+    }
+
+    /// The table of `T`'s fields below `prefix` (defaults `defaults`).
+    pub fn of<T: Params>(prefix: &str, defaults: TableDefaults) -> Self {
+        let entries = T::fields()
+            .into_iter()
+            .map(|f| SchemaEntry::new(join(prefix, f.name), f));
+        Self::new(prefix, defaults, entries.collect())
+    }
+}
+
+/// One settable key: what `_native.task_schema()` lists.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SchemaEntry {
+    /// Its key path (`learner.gamma`, `constraints[].kind`).
+    pub key: String,
+    /// Its name in its table.
+    pub name: &'static str,
+    /// Its meaning.
+    pub doc: String,
+    /// The rule its value must satisfy, in words.
+    pub rule: String,
+    /// Its type as the CLI names it.
+    pub kind: String,
+}
+
+impl SchemaEntry {
+    /// The entry of `field` at `key`.
+    pub fn new(key: String, field: latent_core::FieldInfo) -> Self {
+        Self {
+            key,
+            name: field.name,
+            doc: field.doc,
+            rule: field.rule.to_string(),
+            kind: field.kind,
+        }
     }
 }

@@ -27,13 +27,10 @@ use rand::{Rng, RngExt};
 
 use super::{ConstraintKind, ObstacleTest, RuleCheck, Task, TestStart};
 use crate::error::{Result, SimError};
-use crate::fall::{FallCriteria, reset_on_ground, support_margin};
+use crate::fall::{FallCriteria, GROUND_CLEARANCE, reset_on_ground, support_margin};
 use crate::shapes::{Obstacle, ObstacleShape};
 use crate::urdf::RootMode;
 use crate::world::{Frame, World, WorldSnapshot};
-
-/// Height (m) above the floor of the lowest sole corner at a reset.
-const CLEARANCE: f64 = 5e-4;
 
 /// A resolved constraint: the frames it reads and its test.
 #[derive(Debug, Clone)]
@@ -221,7 +218,7 @@ impl TaskPlant {
                     posture,
                     &fall.soles[0],
                     floor.height,
-                    CLEARANCE,
+                    GROUND_CLEARANCE,
                     rule.stance,
                 )?;
                 let base = self.world.base_pose().translation.z;
@@ -285,6 +282,34 @@ impl TaskPlant {
             .chunks_exact(3)
             .flat_map(|t| (0..3).map(move |k| t[k] + origin[k]))
             .collect()
+    }
+
+    /// Each posture of `postures` (D × M, one per column) put at rest: the code of the rule it
+    /// breaks (0: none; 1 obstacle, 2 outside the joint limits, 3 drop, 4 fall), the effector
+    /// positions and the target's in the world (3E each; they differ by posture if
+    /// `target.relative_to` is set).
+    pub fn classify(&mut self, postures: &nalgebra::DMatrix<f64>) -> Result<Classified> {
+        let d = self.posture_dim();
+        if postures.nrows() != d {
+            return Err(latent_core::CoreError::Shape {
+                what: "postures",
+                expected: format!("(M, {d})"),
+                got: format!("({}, {})", postures.ncols(), postures.nrows()),
+            }
+            .into());
+        }
+        let mut out = Classified {
+            codes: Vec::with_capacity(postures.ncols()),
+            effectors: Vec::new(),
+            targets: Vec::new(),
+        };
+        for q in postures.column_iter() {
+            let q: Vec<f64> = q.iter().copied().collect();
+            out.codes.push(self.reset(&q).map_or(0, |e| e.code() as i8));
+            out.effectors.extend_from_slice(self.effectors());
+            out.targets.extend(self.target_position());
+        }
+        Ok(out)
     }
 
     /// `R(h) = exp(−θ ‖(h − h*)/ℓ‖²)` (paper Eq. 12 with a length unit ℓ) now.
@@ -366,6 +391,15 @@ impl TaskPlant {
     pub fn center_of_mass(&self) -> Result<[f64; 3]> {
         let c = crate::fall::center_of_mass(&self.world)?;
         Ok([c.x, c.y, c.z])
+    }
+
+    /// [`TaskPlant::place`] with the base pose as a recorded row's 7 values (position,
+    /// quaternion x, y, z, w).
+    pub fn place_row(&mut self, posture: &[f64], base: &[f64; 7]) -> Result<()> {
+        let b = base;
+        let rotation = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(b[6], b[3], b[4], b[5]));
+        let pose = nalgebra::Isometry3::from_parts(nalgebra::Translation3::new(b[0], b[1], b[2]), rotation);
+        self.place(posture, &pose)
     }
 
     /// Teleports the robot to `posture` with its base at `base` (a floating root; ignored for a
@@ -527,4 +561,15 @@ impl Plant for TaskPlant {
     fn admits_test_start(&self) -> bool {
         self.task.config().episode.test_start == TestStart::Any || self.started_below
     }
+}
+
+/// What [`TaskPlant::classify`] finds, posture by posture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Classified {
+    /// The code of the rule each posture breaks at rest (0: none).
+    pub codes: Vec<i8>,
+    /// The effector positions, 3E values per posture.
+    pub effectors: Vec<f64>,
+    /// The target in the world, 3E values per posture.
+    pub targets: Vec<f64>,
 }

@@ -72,6 +72,16 @@ impl LatentGrid {
         }
     }
 
+    /// Every point, row-major (`len() × d` values).
+    pub fn points(&self) -> Vec<f64> {
+        let d = self.shape.len();
+        let mut points = vec![0.0; self.len() * d];
+        for (i, p) in points.chunks_exact_mut(d).enumerate() {
+            self.point(i, p);
+        }
+        points
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.shape.iter().product()
@@ -217,6 +227,18 @@ pub struct LearnerGrid {
 }
 
 impl LearnerGrid {
+    /// [`LearnerGrid::new`] once a plant of `task` with `demos` builds: what a survey runs on.
+    pub fn for_survey(
+        task: &Arc<Task>,
+        demos: Option<&[Vec<f64>]>,
+        low: &[f64],
+        high: &[f64],
+        max_points: usize,
+    ) -> Result<Self> {
+        TaskPlant::new(Arc::clone(task), demos)?;
+        Self::new(task, low, high, max_points)
+    }
+
     /// The grid over `[low, high]` at `task`'s learner step with at most `max_points` points.
     pub fn new(task: &Task, low: &[f64], high: &[f64], max_points: usize) -> Result<Self> {
         let learner = Learner::new(&task.config().learner, task.episode_rules(), low, high)

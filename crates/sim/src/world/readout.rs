@@ -104,6 +104,23 @@ impl World {
             .collect()
     }
 
+    /// [`World::link_poses`] as rows of 7 values (position, quaternion x, y, z, w), NaN for a
+    /// link without a pose.
+    pub fn link_pose_rows(&self) -> Vec<f64> {
+        let poses = self.link_poses();
+        let mut out = Vec::with_capacity(7 * poses.len());
+        for pose in &poses {
+            match pose {
+                Some(p) => {
+                    out.extend(p.translation.vector.iter());
+                    out.extend(p.rotation.coords.iter());
+                }
+                None => out.extend([f64::NAN; 7]),
+            }
+        }
+        out
+    }
+
     /// World pose of the root link.
     pub fn base_pose(&self) -> Isometry3<f64> {
         self.world

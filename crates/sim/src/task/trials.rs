@@ -1,0 +1,65 @@
+//! The one trial runner of a task (Exp 2, Exp 3, `latentrl train`, a saved policy's rollouts):
+//! trials of the task's latent learner (`task.learner`, `task.episode`) in parallel, one
+//! [`TaskPlant`] per trial (a fresh world per episode for a floating robot). Python and the
+//! Rust tests run this same assembly.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize};
+
+use latent_core::trials::LatentSpace;
+use latent_core::{CoreError, Learner, TrialOptions, TrialResult, run_trials};
+
+use super::{Task, TaskPlant};
+use crate::error::Result;
+
+/// A task's trials, checked before any runs: the task, demos and maps build a plant and the
+/// learner, the weights fit it, the recorded paths fit in memory.
+#[derive(Debug)]
+pub struct TaskTrials<'a> {
+    task: Arc<Task>,
+    demos: Option<&'a [Vec<f64>]>,
+    latent: &'a LatentSpace<'a>,
+    /// The learner every trial starts from (its grid, actions and weights).
+    pub template: Learner,
+    /// What is run.
+    pub options: TrialOptions,
+}
+
+impl<'a> TaskTrials<'a> {
+    /// The trials of `task` in `latent` with `options`, starting from `weights` (a saved
+    /// policy's; w₀ everywhere if none); `demos` as for [`TaskPlant::new`].
+    pub fn new(
+        task: Arc<Task>,
+        demos: Option<&'a [Vec<f64>]>,
+        latent: &'a LatentSpace<'a>,
+        weights: Option<&[f64]>,
+        options: TrialOptions,
+    ) -> Result<Self> {
+        // One plant and the learner up front: a bad task, demos or maps fail before any trial.
+        let probe = TaskPlant::new(Arc::clone(&task), demos)?;
+        let mut template = Learner::new(&task.config().learner, task.episode_rules(), &latent.low, &latent.high)?;
+        template.check_space(&latent.space(), latent_core::Plant::posture_dim(&probe))?;
+        drop(probe);
+        if let Some(w) = weights {
+            template.set_weights(w)?;
+        }
+        options.check_recording(task.episode_rules().max_steps, task.row_len())?;
+        #[rustfmt::skip]
+        return Ok(Self { task, demos, latent, template, options });
+    }
+
+    /// Runs the trials: see [`run_trials`] for seeding, cancellation, progress and test episodes.
+    pub fn run(&self, cancel: &AtomicBool, done: &AtomicUsize) -> Result<Vec<TrialResult>> {
+        let make = |_| {
+            TaskPlant::new(Arc::clone(&self.task), self.demos).map_err(|e| CoreError::Plant { reason: e.to_string() })
+        };
+        Ok(run_trials(
+            &self.template,
+            &self.latent.space(),
+            make,
+            &self.options,
+            cancel,
+            done,
+        )?)
+    }
+}
