@@ -40,6 +40,32 @@ def test_binding_refuses_bad_inducing_inputs() -> None:
         _native.GpMap(latent, data, np.exp(log_theta), inducing=np.zeros((0, 2)))
 
 
+def test_gradient_holds_where_the_inducing_inputs_are_close() -> None:
+    """At the start of a 1000-posture fit (64 inducing inputs by farthest-point sampling of the
+    PCA start, K_mm's condition number ~1e12) the gradient's slope along itself is the bound's
+    central difference. With A = L⁻¹ K_mn from an explicit L⁻¹ in the native kernel it was off by
+    3e-4 (∂L/∂U 0.03 where it is 1e-5) and L-BFGS stopped after 4 iterations."""
+    from latentrl._base import initial_log_theta
+    from latentrl.pca import PCA
+    from latentrl.recorded.sampling import farthest_points
+
+    X = _arms(1000, 0)
+    pca = PCA(2).fit(X)
+    start, centred = pca.transform(X) / np.sqrt(pca.explained_variance_[0]), X - pca.mean_
+    log_theta = initial_log_theta(start, centred)
+    params = np.concatenate([start.ravel(), start[farthest_points(start, 64)].ravel(), log_theta])
+
+    def bound(p: np.ndarray) -> tuple[float, np.ndarray]:
+        nll, grad, grad_theta, _ = _native.gplvm_nll_grad(p[:2000].reshape(1000, 2), centred, p[-3:],
+                                                          inducing=p[2000:-3].reshape(64, 2))
+        return nll, np.concatenate([grad.ravel(), grad_theta])
+
+    grad = bound(params)[1]
+    step = -1e-4 * grad / np.linalg.norm(grad)
+    central = (bound(params + step)[0] - bound(params - step)[0]) / 2
+    assert central == pytest.approx(grad @ step, rel=2e-5)
+
+
 def _arms(n: int, seed: int) -> np.ndarray:
     from latentrl.datasets import arm_postures
 
@@ -86,9 +112,12 @@ def test_sparse_reconstructs_held_out_postures_about_as_well(fitted: tuple[np.nd
 
 @pytest.mark.slow
 def test_sparse_on_2000_postures_within_1_5x_of_exact() -> None:
+    """The issue's criterion (docs/method.md §Sparse GPLVM has the measured errors and times;
+    `pytest -s` prints them)."""
     X, held_out = _arms(2000, 0), _arms(500, 1)
     exact = _held_out_rmse(GPLVM(random_state=0, tol=1e-4).fit(X), held_out)
     sparse = _held_out_rmse(GPLVM(random_state=0, tol=1e-4, inducing=64).fit(X), held_out)
+    print(f"held-out RMSE: sparse (m = 64) {sparse:.3g}, exact {exact:.3g}")
     assert sparse <= 1.5 * exact, (sparse, exact)
 
 

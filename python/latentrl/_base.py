@@ -541,7 +541,16 @@ def minimise_nll(
         [moved.ravel() if fit_latent else [], log_theta[:2], [max(log_theta[2], floor)]]
     )
     bounds = [(None, None)] * (x0.size - 1) + [(floor, None)]
-    res = lbfgs(objective, x0, bounds, max_iter=max_iter, tol=tol)
+    if inducing is None:
+        res = lbfgs(objective, x0, bounds, max_iter=max_iter, tol=tol)
+    else:
+        # L-BFGS-B's vector operations call BLAS, which OpenBLAS splits over spinning threads from
+        # ~10⁴ variables: on 200k variables (100k postures) and 2 busy cores that cost 30–50× the
+        # optimiser's own work (measured), and the split's rounding changes with the thread count.
+        from threadpoolctl import threadpool_limits
+
+        with threadpool_limits(limits=1, user_api="blas"):
+            res = lbfgs(objective, x0, bounds, max_iter=max_iter, tol=tol)
     points, lt = split(res.x)
     return NllFit(
         np.array(points[:n]),

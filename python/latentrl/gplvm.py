@@ -3,12 +3,13 @@ decodes to the demonstrated postures, with two inverse maps to encode."""
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, ClassVar, Literal, Self, overload
 
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import Estimator, SavedSpec, column_names, initial_log_theta, minimise_nll
+from latentrl._base import Estimator, NllFit, SavedSpec, column_names, initial_log_theta, minimise_nll
 from latentrl import _native
 from latentrl._native import GpMap
 from latentrl._validation import as_matrix, int_at_least, positive
@@ -18,6 +19,10 @@ ENCODERS = ("gp", "projection", "back_constrained", "tracking")
 
 #: Standard deviation of the perturbation of the (unit-scaled) PCA start for each restart.
 RESTART_SCALE = 0.5
+
+#: A sparse fit of more postures than this fits the latent points, inducing inputs and θ of this
+#: many evenly spaced postures first, then all (docs/method.md §Sparse GPLVM).
+SPARSE_FIRST_STAGE = 4096
 
 
 class GPLVM(Estimator):
@@ -248,13 +253,15 @@ class GPLVM(Estimator):
                              "not free points with a prior; use latent_prior=False")
         from latentrl.recorded.sampling import farthest_points
 
-        chosen = np.zeros(0, dtype=np.intp) if inducing is None else farthest_points(start, inducing)
+        rows = sparse_first_stage(len(X))
+        chosen = np.zeros(0, dtype=np.intp) if inducing is None else rows[farthest_points(start[rows], inducing)]
+        options: dict[str, Any] = {"latent_prior": bool(self.latent_prior), "noise_floor": noise_floor,
+                                   "max_iter": max_iter, "tol": tol}
         fits: list[Any] = [
             minimise_back_constrained(z0, centred, log_theta, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
             if back_constrained else
-            minimise_nll(z0, centred, log_theta, fit_latent=True, latent_prior=bool(self.latent_prior),
-                         noise_floor=noise_floor, max_iter=max_iter, tol=tol,
-                         inducing=None if inducing is None else z0[chosen])
+            minimise_nll(z0, centred, log_theta, fit_latent=True, **options) if inducing is None else
+            minimise_sparse(z0, centred, log_theta, rows, chosen, **options)
             for z0 in starts
         ]
         best = min(fits, key=lambda fit: fit.nll)
@@ -420,6 +427,36 @@ class GPLVM(Estimator):
         """Predictive variance σ²(z) (M,) at latent points `Z` (M, d), θ3 included (Eq. 4)."""
         self._check_fitted()
         return self.decoder_.predict(as_matrix("Z", Z, n_cols=self._n_features_out))[1]
+
+
+def sparse_first_stage(n: int) -> NDArray[np.intp]:
+    """The postures of a sparse fit's first stage: all `n`, or `SPARSE_FIRST_STAGE` evenly spaced
+    ones (the first, the last and every (n − 1)/(SPARSE_FIRST_STAGE − 1)-th between)."""
+    if n <= SPARSE_FIRST_STAGE:
+        return np.arange(n)
+    return np.linspace(0, n - 1, SPARSE_FIRST_STAGE).round().astype(np.intp)
+
+
+def minimise_sparse(start: NDArray[np.float64], centred: NDArray[np.float64], log_theta: NDArray[np.float64],
+                    rows: NDArray[np.intp], chosen: NDArray[np.intp], **options: Any) -> NllFit:
+    """The sparse GPLVM's fit from latent points `start` (N, d) of `centred` postures (N, D): the
+    DTC bound minimised over the latent points of `rows`, the inducing inputs (starting at the
+    latent points of the rows `chosen`, a subset of `rows`) and θ; then, if `rows` are not all,
+    over every latent point, each starting where the first stage's out-of-sample GP (a DTC GP
+    from those rows' postures to their latent points, through the `chosen` postures) encodes
+    its posture, and the first stage's inducing inputs and θ. `options` are `minimise_nll`'s;
+    `max_iter` caps each stage, and `n_iter` counts both."""
+    from latentrl.inverse import fit_gp_encoder
+
+    first = minimise_nll(start[rows], centred[rows], log_theta, fit_latent=True, inducing=start[chosen], **options)
+    if len(rows) == len(start):
+        return first
+    encoder = fit_gp_encoder(centred[rows], first.latent, noise_floor=options["noise_floor"],
+                             max_iter=options["max_iter"], tol=options["tol"], inducing=centred[chosen])
+    latent = encoder.predict_mean(centred)
+    latent[rows] = first.latent
+    second = minimise_nll(latent, centred, first.log_theta, fit_latent=True, inducing=first.inducing, **options)
+    return replace(second, n_iter=first.n_iter + second.n_iter)
 
 
 def latent_relevance(Z: NDArray[np.float64], theta: NDArray[np.float64]) -> NDArray[np.float64]:
