@@ -111,9 +111,11 @@ def test_sparse_reconstructs_held_out_postures_about_as_well(fitted: tuple[np.nd
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(7200)
 def test_sparse_on_2000_postures_within_1_5x_of_exact() -> None:
     """The issue's criterion (docs/method.md §Sparse GPLVM has the measured errors and times;
-    `pytest -s` prints them)."""
+    `pytest -s` prints them). The exact fit of 2000 postures alone outlasts the default 600 s
+    timeout on a shared machine (it did: 111 s of CPU in 600 s at load 9; 1233 s measured)."""
     X, held_out = _arms(2000, 0), _arms(500, 1)
     exact = _held_out_rmse(GPLVM(random_state=0, tol=1e-4).fit(X), held_out)
     sparse = _held_out_rmse(GPLVM(random_state=0, tol=1e-4, inducing=64).fit(X), held_out)

@@ -83,7 +83,9 @@ class GPLVM(Estimator):
         start at the latent points of m postures chosen by farthest-point sampling of the start
         latent points (`latentrl.recorded.sampling.farthest_points`: the first, then each time the
         one farthest from those chosen; fewer if fewer are distinct) and are optimised with Z and
-        θ. Decoding is the DTC predictive mean and variance (O(m) and O(m²) per point); the GP
+        θ. Above `SPARSE_FIRST_STAGE` (4096) postures the fit has two stages: Z, the inducing
+        inputs (chosen among them) and θ of 4096 evenly spaced postures, then all latent points
+        from where that stage's GP encoder puts them (`max_iter` caps each stage). Decoding is the DTC predictive mean and variance (O(m) and O(m²) per point); the GP
         encoder is a DTC GP through the postures of those m rows; the projection starts from the
         inducing input whose decoded posture is nearest. Not with encoder="back_constrained".
 
@@ -104,7 +106,7 @@ class GPLVM(Estimator):
     log_likelihood_ : float
         −`nll_`.
     n_iter_ : int
-        L-BFGS-B iterations of the kept start.
+        L-BFGS-B iterations of the kept start (of both stages of a two-stage sparse fit).
     converged_ : bool
         False if the kept start stopped at `max_iter`, or on a failed line search (often
         the limit of floating-point precision; see `stop_reason_`).
