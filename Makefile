@@ -15,7 +15,7 @@ help: ## list the targets
 $(VENV)/.deps: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib "imageio>=2.31" "imageio-ffmpeg>=0.5" "moviepy>=2" "rerun-sdk>=0.23" tqdm gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm "ruff>=0.17,<0.18" scikit-learn pandas "ray>=2.9" "pyarrow>=14" "h5py>=3.10" "rosbags>=0.10"
+	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib "imageio>=2.31" "imageio-ffmpeg>=0.5" "moviepy>=2" "rerun-sdk>=0.23" tqdm threadpoolctl gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm "ruff>=0.17,<0.18" scikit-learn pandas "ray>=2.9" "pyarrow>=14" "h5py>=3.10" "rosbags>=0.10"
 	touch $@
 
 # The old extension is unlinked first: maturin would overwrite it in place, under the feet of a
