@@ -195,3 +195,28 @@ def test_a_moved_train_run_folder_replays_and_plots(run, tmp_path):
     reorder_demos(folder)  # and an input edited since is still refused by name from the new place
     result = latentrl("replay", str(moved), "--test", "0", "--out", str(tmp_path / "x.gif"))
     assert result.returncode == 1 and "its demos changed since the run (sha256 " in result.stderr, result.stderr
+
+
+def test_an_edited_collision_mesh_is_refused_by_name(tmp_path):
+    """Issue #38: a run records the SHA-256 of every collision mesh its robot reads; `--resume`
+    after the mesh was edited is refused naming the meshes (it had been continued)."""
+    from test_issue38_files import cube_stl
+
+    for name in ("glass_arm.toml", "demos.csv"):
+        shutil.copy(EXAMPLE / name, tmp_path / name)
+    urdf = (EXAMPLE / "glass_arm.urdf").read_text()
+    capsule = '<capsule radius="0.015" length="0.07"/>'  # the hand's
+    assert capsule in urdf
+    (tmp_path / "glass_arm.urdf").write_text(urdf.replace(capsule, '<mesh filename="hand.stl" scale="0.07 0.03 0.03"/>'))
+    (tmp_path / "hand.stl").write_bytes(cube_stl())
+    args = ["train", str(tmp_path / "glass_arm.toml"), "--demos", str(tmp_path / "demos.csv"), "--out",
+            str(tmp_path / "out"), "--quick", "--trials", "1", "--episodes", "3", "--test-episodes", "1",
+            "--episode.max-steps", "10", "--no-progress"]
+    first = latentrl(*args)
+    assert first.returncode == 0, first.stderr
+    assert "meshes" in json.loads((tmp_path / "out" / "results.json").read_text())["setup"]["inputs"]
+    stl = bytearray(cube_stl())
+    stl[0] = ord("x")  # the 80-byte header: other bytes, the same cube
+    (tmp_path / "hand.stl").write_bytes(bytes(stl))
+    result = latentrl(*args, "--resume")
+    assert result.returncode == 1 and "its meshes changed since the run (sha256 " in result.stderr, result.stderr

@@ -27,6 +27,9 @@ MAX_TASK_FILE_BYTES = 1 << 20
 MAX_URDF_BYTES = 16 << 20
 """The largest URDF read: 16 MiB, as the native reader (`sim::MAX_URDF_BYTES`)."""
 
+MAX_MESH_BYTES = 128 << 20
+"""The largest collision mesh read: 128 MiB, as the native loader (`sim::urdf::mesh::MAX_MESH_BYTES`)."""
+
 MAX_JSON_BYTES = 64 << 20
 """The largest JSON file of a run read (results.json, rollout.json, a sweep cell's meta): 64 MiB."""
 

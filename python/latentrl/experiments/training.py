@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded
+from latentrl._files import MAX_MESH_BYTES, MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded
 from latentrl.demos import load_demos
 from latentrl.recorded import recording_kind
 from latentrl.recorded.options import DemoOptions
@@ -122,19 +122,24 @@ def setup(run: TrainRun, out: Path | None = None) -> Setup:
 
 
 def input_digests(task_file: str, task: Task, demos: np.ndarray, model: Mapping[str, np.ndarray]) -> dict[str, str]:
-    """SHA-256 of what a run is made from: the task file's and the URDF's bytes, the demo
+    """SHA-256 of what a run is made from: the task file's and the URDF's bytes, its collision
+    meshes' (by file name and bytes, if it has any: a moved robot folder keeps them), the demo
     postures as the learner gets them (joint order, float64) and the GPLVM's arrays as saved
     (`model`: a run's gplvm.npz as read, so a parameter a later version adds does not change
     it); a resume compares them (`RunFolder.check_inputs`)."""
     def sha(data: bytes) -> str:
         return hashlib.sha256(data).hexdigest()
 
-    return {
+    digests = {
         "task file": sha(read_bounded(task_file, MAX_TASK_FILE_BYTES, "a task file")),
         "urdf": sha(read_bounded(task.urdf_path, MAX_URDF_BYTES, "a URDF")),
         "demos": sha(np.ascontiguousarray(demos, dtype=np.float64).tobytes()),
         "model": sha(b"".join(k.encode() + np.ascontiguousarray(model[k]).tobytes() for k in sorted(model))),
     }
+    meshes = sorted({Path(s["file"]) for s in task._native.collision_shapes() if s.get("file")}, key=lambda p: p.name)
+    if meshes:
+        digests["meshes"] = sha(b"".join(m.name.encode() + read_bounded(m, MAX_MESH_BYTES, "a mesh") for m in meshes))
+    return digests
 
 
 def save_policy(run: TrainRun, out: Path) -> LatentPolicy:
