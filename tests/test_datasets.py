@@ -11,10 +11,10 @@ from latentrl.datasets import (
     SHOULDERS,
     arm_hands,
     arm_postures,
-    arms_forward,
     bimanual_pairs,
     grip_error,
 )
+from latentrl._reference import arms_forward
 
 
 def test_bimanual_pairs_satisfy_the_constraint_in_the_box():

@@ -5,7 +5,8 @@ import pytest
 
 from latentrl import InvalidInputError
 from latentrl._native import arms_elbows, arms_fk, arms_ik
-from latentrl.datasets import SHOULDERS, arm_hands, arms_forward
+from latentrl._reference import arms_forward
+from latentrl.datasets import SHOULDERS, arm_hands
 
 
 def random_postures(n=500, seed=0):

@@ -31,7 +31,8 @@ from sklearn.utils.estimator_checks import (  # noqa: E402
 )
 
 from latentrl import GPLVM, PCA  # noqa: E402
-from latentrl.datasets import arm_postures, arms_forward  # noqa: E402
+from latentrl._native import arms_fk  # noqa: E402
+from latentrl.datasets import arm_postures  # noqa: E402
 
 #: The instances checked: GPLVM with a small iteration cap, so the ~50 checks (a few dozen
 #: fits each on up to 150 points) stay within seconds. The cap changes no code path. The
@@ -135,7 +136,7 @@ def test_grid_search_over_n_components(postures: Any) -> None:
     The demos have two degrees of freedom: one latent dimension is too few. (PCA and the
     GPLVM have no `score` of their own: the GPLVM's likelihood is of its training latent
     points, with no held-out counterpart to compare across dimensions.)"""
-    hands = arms_forward(postures.to_numpy())[:, :2]
+    hands = np.asarray(arms_fk(np.ascontiguousarray(postures.to_numpy())))[:, :2]
     for estimator, grid in [(PCA(), [1, 2, 3]), (GPLVM(max_iter=30, random_state=0), [1, 2])]:
         steps = [("scale", StandardScaler()), ("latent", estimator), ("ridge", Ridge(1e-6))]
         pipe = Pipeline(steps)

@@ -1,12 +1,16 @@
 """Plain-NumPy reference versions of the GP maths (dense, with `np.linalg`): the SE kernel
 (paper Eq. 2), GP prediction (Eq. 4) and the GPLVM objective and gradient (Eq. 1, 3), the
-normalised RBF features, the TD(0) step and a learner's value function over its latent grid.
-Tests check the Rust core against them; benches use them as the baseline."""
+normalised RBF features, the TD(0) step, a learner's value function over its latent grid and the
+two planar arms' forward kinematics. Tests check the Rust core against them; benches use them as
+the baseline."""
 
 from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
+
+from latentrl._validation import as_matrix
+from latentrl.datasets import LINKS, SHOULDERS
 
 Array = NDArray[np.float64]
 
@@ -104,3 +108,21 @@ def value_function(
         phi = np.where(d2 <= cutoff**2, phi, 0.0)
     values: NDArray[np.float64] = (phi @ weights) / phi.sum(axis=1)
     return values
+
+
+def arms_forward(postures: NDArray[np.float64], *, elbows: bool = False) -> NDArray[np.float64]:
+    """NumPy forward kinematics: hands (N, 4) `[x_L, y_L, x_R, y_R]` of postures (N, 4)
+    `[q1_L, q2_L, q1_R, q2_R]` — `q1` from the +x axis, `q2` relative to the upper arm. With
+    `elbows=True`, the elbow positions (N, 4) instead."""
+    q = as_matrix("postures", postures, n_cols=4)
+    l1, l2 = LINKS
+    out = np.empty_like(q)
+    for arm in (0, 1):
+        q1, q12 = q[:, 2 * arm], q[:, 2 * arm] + q[:, 2 * arm + 1]
+        ex = SHOULDERS[arm, 0] + l1 * np.cos(q1)
+        ey = SHOULDERS[arm, 1] + l1 * np.sin(q1)
+        if elbows:
+            out[:, 2 * arm], out[:, 2 * arm + 1] = ex, ey
+        else:
+            out[:, 2 * arm], out[:, 2 * arm + 1] = ex + l2 * np.cos(q12), ey + l2 * np.sin(q12)
+    return out

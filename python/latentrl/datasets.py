@@ -1,7 +1,6 @@
 """Demonstration generators for the bimanual task (docs/method.md §Experiment 1, §Experiment 2):
-postures that satisfy the constraint "the right hand is 0.1 m to the right of the left hand", plus a
-NumPy forward kinematics of the two planar arms (the reference the Rust `arms_fk` is tested
-against).
+postures that satisfy the constraint "the right hand is 0.1 m to the right of the left hand" (the
+arms' kinematics are native: `_native.arms_fk`; `_reference.arms_forward` is its NumPy oracle).
 
 Every generator takes a seeded `numpy.random.Generator` and is deterministic given it.
 
@@ -140,24 +139,6 @@ def arm_postures(
     if noise > 0:
         postures = postures + rng.normal(scale=noise, size=postures.shape)
     return postures
-
-
-def arms_forward(postures: NDArray[np.float64], *, elbows: bool = False) -> NDArray[np.float64]:
-    """NumPy forward kinematics: hands (N, 4) `[x_L, y_L, x_R, y_R]` of postures (N, 4)
-    `[q1_L, q2_L, q1_R, q2_R]` — `q1` from the +x axis, `q2` relative to the upper arm. With
-    `elbows=True`, the elbow positions (N, 4) instead."""
-    q = as_matrix("postures", postures, n_cols=4)
-    l1, l2 = LINKS
-    out = np.empty_like(q)
-    for arm in (0, 1):
-        q1, q12 = q[:, 2 * arm], q[:, 2 * arm] + q[:, 2 * arm + 1]
-        ex = SHOULDERS[arm, 0] + l1 * np.cos(q1)
-        ey = SHOULDERS[arm, 1] + l1 * np.sin(q1)
-        if elbows:
-            out[:, 2 * arm], out[:, 2 * arm + 1] = ex, ey
-        else:
-            out[:, 2 * arm], out[:, 2 * arm + 1] = ex + l2 * np.cos(q12), ey + l2 * np.sin(q12)
-    return out
 
 
 def grip_error(

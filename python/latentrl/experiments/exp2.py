@@ -25,7 +25,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl.datasets import arm_postures, arms_forward, grip_error
+from latentrl._native import arms_fk
+from latentrl.datasets import arm_postures, grip_error
 from latentrl.experiments.latent_runs import Fitted, latent_setup, recorded_episodes, run_fit
 from latentrl.experiments.presets import LatentRun, check_ints, latent_box
 from latentrl.pca import PCA
@@ -180,7 +181,7 @@ def _fig5(preset: Exp2Preset, fitted: Fitted, out: Path) -> None:
     for ax, (name, model, latent) in zip(axes, methods):
         low, high = latent_box(latent, preset.latent_margin)
         samples = rng.uniform(low, high, size=(preset.fig5_samples, 2))
-        ok = grip_error(arms_forward(model.inverse_transform(samples))) <= GRIP_TEST_TOLERANCE
+        ok = grip_error(arms_fk(model.inverse_transform(samples))) <= GRIP_TEST_TOLERANCE
         ax.plot(*samples[~ok].T, ".", color="tab:red", ms=3, label="constraint broken")
         ax.plot(*samples[ok].T, ".", color="tab:green", ms=3, label="constraint kept")
         ax.plot(*latent.T, "k.", ms=4, label="demonstrations")

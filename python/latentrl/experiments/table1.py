@@ -31,7 +31,8 @@ from typing import Any, Literal
 import numpy as np
 
 from latentrl._base import atomic_write
-from latentrl.datasets import arm_postures, arms_forward, bimanual_pairs, grip_error
+from latentrl._native import arms_fk
+from latentrl.datasets import arm_postures, bimanual_pairs, grip_error
 from latentrl.experiments.presets import check_encoder, check_floats, check_ints, describe
 from latentrl.experiments.results import environment, worker_threads, write_json
 
@@ -170,8 +171,8 @@ def _evaluate(
 ) -> dict[str, Any]:
     """Reconstruction error and constraint shares of one fitted model (PCA or GPLVM)."""
     recon = model.inverse_transform(model.transform(test))
-    hands_true = arms_forward(test) if joint else test
-    hands_recon = arms_forward(recon) if joint else recon
+    hands_true = arms_fk(test) if joint else test
+    hands_recon = arms_fk(recon) if joint else recon
     out: dict[str, Any] = {
         "recon": 100.0 * float(np.sqrt(np.mean((hands_recon - hands_true) ** 2))),
         "recon_joint": 100.0 * float(np.sqrt(np.mean((recon - test) ** 2))) if joint else None,
@@ -182,7 +183,7 @@ def _evaluate(
     for margin in preset.margins():
         samples = (low - margin * width) + unit * (width * (1 + 2 * margin))
         decoded = model.inverse_transform(samples)
-        hands = arms_forward(decoded) if joint else decoded
+        hands = arms_fk(decoded) if joint else decoded
         out["constraint"][_margin_key(margin)] = {
             test_name: 100.0 * float(np.mean(grip_error(hands, test=test_name) <= preset.tolerance))
             for test_name in CONSTRAINT_TESTS
