@@ -1,6 +1,7 @@
 """Demonstration generators for the bimanual task (docs/method.md §Experiment 1, §Experiment 2):
 postures that satisfy the constraint "the right hand is 0.1 m to the right of the left hand" (the
-arms' kinematics are native: `_native.arms_fk`; `_reference.arms_forward` is its NumPy oracle).
+arms' kinematics, `arms_forward`, are the native plant's; `_reference.arms_forward` is their NumPy
+oracle).
 
 Every generator takes a seeded `numpy.random.Generator` and is deterministic given it.
 
@@ -23,7 +24,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._native import arms_ik
+from latentrl._native import arms_elbows, arms_fk, arms_ik
 from latentrl._validation import as_matrix, int_at_least
 
 OFFSET = np.array([0.1, 0.0])
@@ -139,6 +140,16 @@ def arm_postures(
     if noise > 0:
         postures = postures + rng.normal(scale=noise, size=postures.shape)
     return postures
+
+
+def arms_forward(postures: NDArray[np.float64], *, elbows: bool = False) -> NDArray[np.float64]:
+    """Hands (N, 4) `[x_L, y_L, x_R, y_R]` of postures (N, 4) `[q1_L, q2_L, q1_R, q2_R]` — `q1`
+    from the +x axis, `q2` relative to the upper arm; with `elbows=True`, the elbows (N, 4). The
+    plant's own kinematics (`_native.arms_fk`, `arms_elbows`); `_reference.arms_forward` is the
+    NumPy oracle they are tested against."""
+    q = np.ascontiguousarray(as_matrix("postures", postures, n_cols=4))
+    hands: NDArray[np.float64] = np.asarray((arms_elbows if elbows else arms_fk)(q))
+    return hands
 
 
 def grip_error(
