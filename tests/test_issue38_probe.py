@@ -5,6 +5,7 @@ a message naming no file, or a half-written run folder."""
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator
 import re
 import subprocess
 import sys
@@ -109,12 +110,13 @@ def test_a_video_that_cannot_be_written_names_its_file(tmp_path: Path, monkeypat
 
     from latentrl import replay
 
-    def full(*args: object) -> None:
+    def frames_on_a_full_disk() -> Iterator[np.ndarray]:  # the write fails while the frames stream in
+        yield np.zeros((2, 2, 3), np.uint8)
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(replay, "_write_video", full)
     with pytest.raises(OSError, match=rf"cannot write {re.escape(str(tmp_path / 'v.gif'))}: No space left on device"):
-        replay.write_video(iter([np.zeros((2, 2, 3), np.uint8)]), tmp_path / "v.gif", 10)
+        replay.write_video(frames_on_a_full_disk(), tmp_path / "v.gif", 10)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_task_from_a_list_is_a_type_error_naming_its_origin() -> None:

@@ -39,25 +39,33 @@ class NotFittedError(LatentrlError, AttributeError):
     """An estimator used before `fit`: a ValueError and an AttributeError, as in scikit-learn."""
 
 
+@contextlib.contextmanager
+def naming_os_errors(path: Path) -> Iterator[None]:
+    """An OSError raised inside (a full disk, a read-only folder) names `path`, unless it already
+    does: `cannot write PATH: No space left on device` (issue #38)."""
+    try:
+        yield
+    except OSError as err:
+        if str(path) in str(err):
+            raise
+        raise type(err)(err.errno, f"cannot write {path}: {err.strerror or err}") from err
+
+
 def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
     """Calls `write` (its result is ignored) on a temporary file beside `path` (creating
     missing parent directories), flushes it to disk, then renames it over `path`, so an
     interrupted write never leaves a half-written file. A process killed mid-write leaves
-    only `.{name}.<hex>.tmp` behind. An OSError (a full disk, a read-only folder) names `path`."""
+    only `.{name}.<hex>.tmp` behind. An OSError names `path` (`naming_os_errors`)."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with open(tmp, "xb") as fh:
-            write(fh)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except OSError as err:
-        tmp.unlink(missing_ok=True)
-        if str(path) in str(err):
-            raise
-        raise type(err)(err.errno, f"cannot write {path}: {err.strerror or err}") from err
+        with naming_os_errors(path):
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with open(tmp, "xb") as fh:
+                write(fh)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, path)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
@@ -67,12 +75,14 @@ def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
 def atomic_path(path: PathLike) -> Iterator[Path]:
     """A temporary file name beside `path` that keeps its suffix (for writers that take a name
     and choose the format by it: imageio, rerun), renamed over `path` when the block ends and
-    removed if it raises, so such a writer never leaves a half-written `path`."""
+    removed if it raises, so such a writer never leaves a half-written `path`; an OSError in the
+    block names `path` (`naming_os_errors`)."""
     path = Path(path)
     tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex}.tmp{path.suffix}")
     try:
-        yield tmp
-        os.replace(tmp, path)
+        with naming_os_errors(path):
+            yield tmp
+            os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
 

@@ -192,16 +192,7 @@ def write_video(frames: Iterable[NDArray[np.uint8]], out: Path, fps: int) -> Non
     temporary file, so a failed or interrupted write leaves nothing half-written. Memory stays
     bounded: an MP4's frames stream to ffmpeg (imageio's writer), a GIF keeps each frame
     quantised to its 256-colour palette (Pillow, one byte per pixel) until it is saved. A write
-    that fails (a full disk) is an OSError naming `out` (issue #38)."""
-    try:
-        _write_video(frames, out, fps)
-    except OSError as err:
-        if err.filename is not None or str(out) in str(err):
-            raise
-        raise OSError(err.errno, f"cannot write {out}: {err.strerror or err}") from None
-
-
-def _write_video(frames: Iterable[NDArray[np.uint8]], out: Path, fps: int) -> None:
+    that fails (a full disk) is an OSError naming `out` (`atomic_path`, issue #38)."""
     with atomic_path(out) as temp:
         if out.suffix.lower() == ".gif":
             from PIL import Image
