@@ -336,13 +336,13 @@ pub fn survey(
         all.effectors.extend(p.effectors);
         all.blocked.extend(p.blocked);
     }
+    let closest = (0..n)
+        .filter(|&i| all.codes[i] == 0)
+        .min_by(|&a, &b| all.distance[a].total_cmp(&all.distance[b]))
+        .map(|i| closest_of(grid, &all, i, e));
     let (region_points, closest) = if grid.stride() > 1 {
-        refine(task, demos, decoder, grid, &mut all, cancel)?
+        refine(task, demos, decoder, grid, &mut all, closest, cancel)?
     } else {
-        let closest = (0..n)
-            .filter(|&i| all.codes[i] == 0)
-            .min_by(|&a, &b| all.distance[a].total_cmp(&all.distance[b]))
-            .map(|i| closest_of(grid, &all, i, e));
         (all.reached.iter().filter(|r| **r).count(), closest)
     };
     let moves_to_target = fewest_moves(grid, &all.codes, &all.reached, &at.moves, &[]);
@@ -381,13 +381,15 @@ fn closest_of(grid: &LatentGrid, all: &Part, i: usize, e: usize) -> Closest {
 /// Looks into cells of a grid at a stride > 1 again at the learner's step (module docs): the
 /// cells of the decoder's inputs and of the `REFINED_CLOSEST` admissible points closest to the
 /// target, closest first, at most as many points as the grid has. Marks the cells with a reached
-/// point reached in `all`; returns the region's points and the closest admissible point.
+/// point reached in `all`; returns the region's points and the closest admissible point, the
+/// grid's `closest` unless a cell holds a closer one.
 fn refine(
     task: &Arc<Task>,
     demos: Option<&[Vec<f64>]>,
     decoder: &GpMap,
     grid: &LatentGrid,
     all: &mut Part,
+    mut closest: Option<Closest>,
     cancel: &AtomicBool,
 ) -> Result<(usize, Option<Closest>)> {
     let (n, d) = (grid.len(), grid.shape().len());
@@ -437,7 +439,6 @@ fn refine(
         .collect::<Result<Vec<_>>>()?;
     let mut looked = vec![false; n];
     let mut region = 0;
-    let mut closest = admissible.first().map(|&i| closest_of(grid, all, i, e));
     for (&cell, (reached, best)) in cells.iter().zip(found) {
         looked[cell] = true;
         region += reached;
