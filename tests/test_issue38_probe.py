@@ -104,7 +104,7 @@ def test_a_task_env_refuses_an_action_that_is_not_its_joints_finite_values(actio
         env.step(action)  # type: ignore[arg-type]
 
 
-def test_a_video_that_cannot_be_written_names_its_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_video_that_cannot_be_written_names_its_file(tmp_path: Path) -> None:
     """Issue #38: `latentrl replay --out` on a full disk said only "[Errno 28] No space left on device"."""
     import errno
 
