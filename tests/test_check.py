@@ -156,11 +156,46 @@ def test_the_step_keeps_the_path_within_half_an_episode():
 
     spans = {1.0: 0.0, 0.5: 1.0, 0.25: 2.2, 0.125: 4.5, 0.0625: 8.5}
     moves = {1.0: 20, 0.5: 41, 0.25: 82, 0.125: 164, 0.0625: 330}
-    step, _, rule = learner_step(surveys(spans, moves), budget=200)
-    assert step == 0.25 and "82 moves" in rule and "would be 0.125" in rule
+    step, _, rule, fits = learner_step(surveys(spans, moves), budget=200)
+    assert step == 0.25 and "82 moves" in rule and "would be 0.125" in rule and fits
     assert learner_step(surveys(spans, moves), budget=1000)[0] == 0.125  # room to spare: the span rule
-    assert learner_step(surveys(spans, dict.fromkeys(moves, 10000)), budget=200)[0] == 0.125  # nothing fits: span
+    nothing_fits = learner_step(surveys(spans, dict.fromkeys(moves, 10000)), budget=200)
+    assert nothing_fits[0] == 0.125 and not nothing_fits[3]  # the span rule, and the spacing rule's cue
     assert learner_step(surveys(dict.fromkeys(spans, 0.0), moves), budget=200) is None
+
+
+@pytest.mark.parametrize(("fit_moves", "spaced"), [(82, False), (10000, True)])
+def test_the_latent_points_are_spaced_evenly_only_where_no_step_fits(monkeypatch, fit_moves, spaced):
+    """`derive.derive` with `even`: the evenly spaced model (and the `latent_spacing` record) only
+    where the fit's points leave no step whose region spans 3 steps within half an episode;
+    a model read back already spaced keeps its record without a new fit."""
+    from types import SimpleNamespace
+
+    from latentrl import derive as derive_module
+
+    def survey(task, model, low, high, demos):
+        step = task.to_dict()["learner"]["step"]
+        moves = {"fit": fit_moves, "even": 40}[model.spacing]
+        return {"region_points": 16 if step <= 0.25 else 0, "shape": (10, 10), "stride": 1,
+                "moves": np.full(20, moves)}
+
+    monkeypatch.setattr(derive_module, "survey_at_step", survey)
+    monkeypatch.setattr(derive_module, "servo_gains", lambda task, demos: [])
+    task = Task.shipped("two_arms").replace({"episode.max_steps": 200})
+    fits, even = SimpleNamespace(spacing="fit"), SimpleNamespace(spacing="even")
+    made = []
+
+    def make_even():
+        made.append(1)
+        return even
+
+    found = {d.key: d.value for d in derive_module.derive(task, fits, None, None, None, {"episode.max_steps"}, make_even)}
+    assert (found.get("latent_spacing") == "even") == spaced and len(made) == int(spaced)
+    assert found["learner.step"] == 0.25
+    again = {d.key: d.value for d in derive_module.derive(task, even, None, None, None, {"episode.max_steps"}, make_even)}
+    assert again["latent_spacing"] == "even" and len(made) == int(spaced)
+    assert "latent_spacing" not in {d.key for d in derive_module.derive(task, fits, None, None, None,
+                                                                        {"episode.max_steps"})}
 
 
 def test_servo_gains_are_derived_where_the_task_is_silent():

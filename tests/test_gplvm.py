@@ -238,6 +238,7 @@ def test_params_and_repr():
         "max_components",
         "relevance_threshold",
         "inducing",
+        "spacing",
     }
 
 

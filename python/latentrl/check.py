@@ -30,7 +30,9 @@ The findings, in order (docs/tasks.md, "Before training: latentrl check"):
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cache, partial
 from typing import Any
 
 import numpy as np
@@ -115,7 +117,7 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     module docs, with the settings `train` would derive where the task is silent; `model`: a
     fitted GPLVM (default: one fitted here, d = 2, seed 0, as `train` fits); `latent_margin`: the
     box's margin (default: `TrainPreset`'s)."""
-    from latentrl.derive import applied, derive
+    from latentrl.derive import SPACING, applied, derive
     from latentrl.experiments.presets import latent_box
     from latentrl.gplvm import GPLVM
     from latentrl.train import TrainPreset
@@ -125,11 +127,21 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
         raise ValueError(f"demos: expected finite postures of shape (N, {len(task.joint_names)}) for {task.name}, "
                          f"got {postures.shape}")
     preset = TrainPreset()
-    if model is None:
-        model = GPLVM(n_components=2, random_state=0, max_iter=preset.gplvm_max_iter, encoder=preset.encoder).fit(postures)
+    even: Callable[[], Any] | None = None
+    if model is None:  # fitted as `latentrl train` fits, its latent spacing derived as there
+
+        @cache
+        def fit(spacing: str) -> GPLVM:
+            return GPLVM(n_components=2, random_state=0, max_iter=preset.gplvm_max_iter, encoder=preset.encoder,
+                         spacing=spacing).fit(postures)
+
+        model, even = fit("fit"), partial(fit, "even")
     low, high = latent_box(model.Z_, preset.latent_margin if latent_margin is None else latent_margin)
     if demo_finding(task, postures).verdict != "will not learn":  # else nothing to derive from: say why
-        task = applied(task, derive(task, model, low, high, postures, set(task.given)))
+        derived = derive(task, model, low, high, postures, set(task.given), even)
+        if even is not None and any(d.key == SPACING for d in derived):
+            model = even()
+        task = applied(task, derived)
     return check_task(task, postures, model, low, high, budget=(preset.trials, preset.episodes))
 
 
@@ -182,8 +194,10 @@ def demo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
 
 def fit_finding(model: Any) -> Finding:
     """Whether the GPLVM fit converged."""
+    spaced = ("; its latent points evenly spaced along each axis (the fit's own left no learner step that lands "
+              "in the target region within half an episode)" if getattr(model, "spacing", "fit") == "even" else "")
     if getattr(model, "converged_", True):
-        return Finding("fit", "ok", f"the GPLVM converged in {getattr(model, 'n_iter_', '?')} iterations")
+        return Finding("fit", "ok", f"the GPLVM converged in {getattr(model, 'n_iter_', '?')} iterations{spaced}")
     return Finding("fit", "warning", f"the GPLVM stopped unconverged after {model.n_iter_} iterations",
                    f"raise --gplvm-max-iter above {model.n_iter_}", {"n_iter": int(model.n_iter_)})
 

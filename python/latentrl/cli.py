@@ -251,6 +251,9 @@ def _fit_flags(fit: argparse.ArgumentParser) -> None:
     fit.add_argument("--max-iter", type=int, default=1000, help="L-BFGS iteration cap of the GPLVM (default: 1000)")
     fit.add_argument("--inducing", type=int, metavar="M", help="fit the sparse GPLVM through M inducing inputs, "
                      "for many postures (docs/method.md#sparse-gplvm; default: the exact GPLVM, at most 16384 postures)")
+    fit.add_argument("--spacing", choices=("fit", "even"), default="fit",
+                     help="GPLVM latent points as fitted, or evenly spaced along each axis (docs/encoders.md#latent-spacing; "
+                          "default: fit; `latentrl train` fits with even)")
     fit.add_argument("--out", type=Path, required=True, help="the model file to write (.npz; load with GPLVM.load)")
     _add_preset_flags(fit, DemoOptions)
 
@@ -397,7 +400,8 @@ def _train(args: argparse.Namespace) -> int:
     for warning in task.warnings:
         print(f"latentrl: warning: {warning}", file=sys.stderr)
     for found in settings:
-        print(f"derived {found.key} = {found.value:g}: {found.rule}")
+        value = found.value if isinstance(found.value, str) else f"{found.value:g}"
+        print(f"derived {found.key} = {value}: {found.rule}")
     command = "the same latentrl train command with --resume"
     code = _interruptible(lambda: run_training(run, args.out, progress=args.progress), args.out, command)
     if code == 0:
@@ -517,7 +521,7 @@ def _fit(args: argparse.Namespace) -> int:
         model: Any = PCA(n_components=args.n_components)
     else:
         model = GPLVM(n_components=args.n_components, max_iter=args.max_iter, random_state=args.seed,
-                      inducing=args.inducing)
+                      inducing=args.inducing, spacing=args.spacing)
     model.fit(demos.postures)
     model.save(args.out)
     episodes = {} if demos.episodes is None else {"episodes": len(set(demos.episodes.tolist()))}

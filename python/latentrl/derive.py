@@ -17,6 +17,11 @@ The rules (docs/tasks.md, "Settings derived from the data"):
   least `SPAN` steps across, so a move can land inside it and stay — unless 95 % of the starts
   would then need more than 1/`FIT` of `episode.max_steps` moves to reach it: then the smallest
   step at which they need at most that (reaching the target first, landing in it second);
+- `latent_spacing` (with `latent_spacing = "auto"`, `latentrl train`'s default): "even" (the
+  GPLVM's points evenly spaced along each axis, `GPLVM(spacing="even")`) when the fit's own points
+  leave no step above at which the target region spans `SPAN` steps and 95 % of the starts reach
+  it within 1/`FIT` of an episode — the fit packed the demos near the target into a cluster no one
+  step suits — and the step then derived on the evenly spaced points;
 - `episode.max_steps` = `SLACK` × the moves that 95 % of admissible starts need to the target at
   that step (at least `MIN_STEPS`, at most the schema's default);
 - `episode.stop_window` = `STOP_WINDOW`: a trial stops once 3 windows of that many episodes in a
@@ -82,9 +87,11 @@ class Derived:
 
 
 def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.float64],
-           demos: NDArray[np.float64], given: set[str]) -> list[Derived]:
+           demos: NDArray[np.float64], given: set[str], even: Callable[[], Any] | None = None) -> list[Derived]:
     """The settings of the module docs that `given` (the keys the task file and the flags set)
-    leaves open, for `task` in the latent box [`low`, `high`] of `model`."""
+    leaves open, for `task` in the latent box [`low`, `high`] of `model`. With `even` (the same
+    GPLVM fitted with `spacing="even"`, made when called), the latent spacing too: the caller
+    trains on `even()` if the result holds `SPACING`."""
     out = []
     config = task.to_dict()
     if not any(key.startswith("servo.") for key in given):
@@ -98,9 +105,18 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
     survey = None
     if "learner.step" not in given:
         budget = config["episode"]["max_steps"] if "episode.max_steps" in given else _default("episode.max_steps")
-        found = learner_step(lambda s: survey_at_step(task.replace({"learner.step": s}), model, low, high, demos), budget)
+
+        def step_on(m: Any) -> tuple[float, dict[str, Any], str, bool] | None:
+            return learner_step(lambda s: survey_at_step(task.replace({"learner.step": s}), m, low, high, demos), budget)
+
+        spaced = even is not None and getattr(model, "spacing", "fit") == "even"  # a run's model, read back
+        found = None if spaced else step_on(model)
+        if even is not None and (spaced or found is None or not found[3]):
+            model = model if spaced else even()
+            out.append(Derived(SPACING, "even", SPACING_RULE))
+            found = step_on(model)
         if found is not None:
-            step, survey, rule = found
+            step, survey, rule, _ = found
             out.append(Derived("learner.step", step, rule))
     if "episode.max_steps" not in given:
         survey = survey or survey_at_step(task.replace({"learner.step": step}), model, low, high, demos)
@@ -117,11 +133,13 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
     return out
 
 
-def learner_step(survey_at: Callable[[float], dict[str, Any]], budget: int) -> tuple[float, dict[str, Any], str] | None:
+def learner_step(survey_at: Callable[[float], dict[str, Any]],
+                 budget: int) -> tuple[float, dict[str, Any], str, bool] | None:
     """`learner.step` (module docs): the largest of `STEPS` at which the target region spans
     `SPAN` steps, unless 95 % of the starts then need more than `budget` / `FIT` moves — then the
-    smallest step at which they need at most that, if any; with its survey (`survey_at(step)`)
-    and rule. None if the target region spans `SPAN` steps at no candidate."""
+    smallest step at which they need at most that, if any; with its survey (`survey_at(step)`),
+    rule and whether the starts reach the region within `budget` / `FIT` moves at it. None if the
+    target region spans `SPAN` steps at no candidate."""
     spans = f"the largest of {', '.join(f'{s:g}' for s in STEPS)} RBF spacings at which the target region spans ≥ {SPAN:g} steps"
     fitting = None
     for candidate in STEPS:
@@ -133,12 +151,20 @@ def learner_step(survey_at: Callable[[float], dict[str, Any]], budget: int) -> t
         if span < SPAN:
             continue
         if fits or fitting is None:
-            return candidate, found, f"{spans} (it spans {span:.1f})"
+            return candidate, found, f"{spans} (it spans {span:.1f})", fits
         step, found, span, moves = fitting
         return step, found, (f"{spans} would be {candidate:g}, where 95 % of the starts need more than 1/{FIT:g} of "
                              f"an episode's {budget} steps to reach it: the smallest step at which they need at most "
-                             f"that ({moves} moves; the region spans {span:.1f} steps)")
+                             f"that ({moves} moves; the region spans {span:.1f} steps)"), True
     return None
+
+
+SPACING = "latent_spacing"
+"""The run setting (not a task key) the spacing rule derives: `GPLVM.spacing` of the fit."""
+
+SPACING_RULE = (f"the fit's own latent points leave no learner step at which the target region spans ≥ {SPAN:g} steps "
+                f"and 95 % of the starts reach it within 1/{FIT:g} of an episode: the GPLVM's points evenly spaced "
+                "along each axis (GPLVM(spacing='even'), docs/encoders.md)")
 
 
 def servo_gains(task: Task, demos: NDArray[np.float64]) -> list[Derived]:
@@ -168,7 +194,7 @@ def servo_gains(task: Task, demos: NDArray[np.float64]) -> list[Derived]:
 
 def applied(task: Task, derived: list[Derived] | tuple[Derived, ...]) -> Task:
     """`task` with the `derived` settings set (its origin kept, for error messages)."""
-    return task.replace({d.key: d.value for d in derived}, origin=task.origin)
+    return task.replace({d.key: d.value for d in derived if d.key != SPACING}, origin=task.origin)
 
 
 def _default(key: str) -> Any:

@@ -14,6 +14,7 @@ from latentrl import _native
 from latentrl._native import GpMap
 from latentrl._validation import as_matrix, int_at_least, positive
 from latentrl.pca import PCA, check_n_components
+from latentrl.spacing import SPACINGS, evenly_spaced
 
 ENCODERS = ("gp", "projection", "back_constrained", "tracking")
 
@@ -197,6 +198,7 @@ class GPLVM(Estimator):
         max_components: int | None = None,
         relevance_threshold: float = 0.1,
         inducing: int | None = None,
+        spacing: str = "fit",
     ) -> None:
         self.n_components = n_components
         self.max_components = max_components
@@ -209,6 +211,7 @@ class GPLVM(Estimator):
         self.encoder = encoder
         self.tol = tol
         self.inducing = inducing
+        self.spacing = spacing
 
     def fit(self, X: Any, y: Any = None) -> Self:
         """Fits the latent points and kernel to postures `X` (N, D), an array or DataFrame;
@@ -250,6 +253,11 @@ class GPLVM(Estimator):
         if back_constrained and inducing is not None:
             raise ValueError("inducing: the back-constrained GPLVM is fitted exactly; use inducing=None "
                              "or another encoder")
+        if self.spacing not in SPACINGS:
+            raise ValueError(f"spacing must be one of {', '.join(map(repr, SPACINGS))}, got {self.spacing!r}")
+        if back_constrained and self.spacing != "fit":
+            raise ValueError("spacing: the back-constrained latent points are a function of X and cannot be "
+                             "moved; use spacing='fit' or another encoder")
         if back_constrained and self.latent_prior:
             raise ValueError("latent_prior: the back-constrained latent points are a function of X, "
                              "not free points with a prior; use latent_prior=False")
@@ -267,6 +275,8 @@ class GPLVM(Estimator):
             for z0 in starts
         ]
         best = min(fits, key=lambda fit: fit.nll)
+        if self.spacing == "even":
+            best = evenly_spaced(best, centred, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
 
         self.n_features_in_ = X.shape[1]
         self._set_feature_names(names)

@@ -11,7 +11,7 @@ import json
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -52,14 +52,15 @@ class TrainRun(TrainPreset, DemoOptions):
 
 @lru_cache(maxsize=2)
 def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, model: str,
-          seed: int, max_iter: int, encoder: str) -> tuple[Task, np.ndarray, GPLVM]:
+          seed: int, max_iter: int, encoder: str, spacing: str) -> tuple[Task, np.ndarray, GPLVM]:
     task = Task.load(task_file).replace(json.loads(overrides))
     # A recording's other joints (a gripper, a wheel) are dropped; a file of postures names the robot's.
     recorded = recording_kind(Path(demos)) is not None
     loaded = load_demos(demos, min_postures=3, expected_joints=task.joint_names if recorded else None,
                         **options.load_kwargs())
     postures = task.demo_postures(loaded.joint_names, loaded.postures, demos)
-    gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder)
+    gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder,
+                                                  spacing=spacing)
     if model:
         if gplvm.n_features_in_ != len(task.joint_names):
             raise ValueError(f"{model}: fitted to {gplvm.n_features_in_} joints, the task's robot has {len(task.joint_names)}")
@@ -81,32 +82,56 @@ def fitted(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GP
 
 def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GPLVM, tuple[Derived, ...]]:
     """`fitted`, and the settings `latentrl.derive` derived for it (cached per task, fit and
-    margin)."""
-    from latentrl.derive import applied, derive
+    margin). With `latent_spacing = "auto"` the fit's points are evenly spaced where the derive
+    rule says so (`derive.SPACING`), before a new run saves its model."""
+    from latentrl.derive import SPACING, applied
     from latentrl.experiments.latent_runs import Fitted, run_fit
     from latentrl.experiments.results import RunFolder
 
     overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
     options = DemoOptions(**{f.name: getattr(run, f.name) for f in dataclasses.fields(DemoOptions)})
-    task, demos, model = _load(run.task_file, overrides, run.demos, options, run.model, run.seed, run.gplvm_max_iter,
-                               run.encoder)
+
+    def load(spacing: str) -> tuple[Task, np.ndarray, GPLVM]:
+        return _load(run.task_file, overrides, run.demos, options, run.model, run.seed, run.gplvm_max_iter,
+                     run.encoder, spacing)
+
+    auto = run.latent_spacing == "auto"
+    task, demos, model = load("fit" if auto else run.latent_spacing)
+    even = (lambda: load("even")[2]) if auto and not run.model and run.encoder != "back_constrained" else None
+    if even is not None and any(d.key == SPACING for d in _derived(task, model, demos, run.latent_margin, even)):
+        model = even()
     if out is not None:
         folder = RunFolder(out)  # gplvm.npz and results.json read once, for the fit and the digests
-        model = run_fit(folder, run.latent_margin, lambda: Fitted.of_model(model, run.latent_margin)).model
+        fresh = model
+        model = run_fit(folder, run.latent_margin, lambda: Fitted.of_model(fresh, run.latent_margin)).model
         if folder.results_path.is_file():  # a run read back (resume, replay, rollout, plot): made from these inputs?
             saved = folder.model_arrays()
             folder.check_inputs(input_digests(run.task_file, task, demos, model._arrays() if saved is None else saved))
-    fit = hashlib.sha256(np.ascontiguousarray(model.Z_).tobytes() + np.ascontiguousarray(demos).tobytes())
-    key = (task.digest(), fit.hexdigest(), task.given, run.latent_margin)
-    if key not in _DERIVED:
-        low, high = latent_box(model.Z_, run.latent_margin)
-        _DERIVED[key] = tuple(derive(task, model, low, high, demos, set(task.given)))
-    settings = _DERIVED[key]
+    settings = _derived(task, model, demos, run.latent_margin, even)
     return applied(task, settings), demos, model, settings
 
 
+def _derived(task: Task, model: GPLVM, demos: np.ndarray, margin: float,
+             even: Callable[[], GPLVM] | None) -> tuple[Derived, ...]:
+    """`derive.derive` for `task` on `model` (cached per task, fit, given keys, margin and whether
+    the spacing may be derived; a spacing it derives is cached for the evenly spaced fit too)."""
+    from latentrl.derive import SPACING, derive
+
+    def key(m: GPLVM) -> tuple[Any, ...]:
+        fit = hashlib.sha256(np.ascontiguousarray(m.Z_).tobytes() + np.ascontiguousarray(demos).tobytes())
+        return task.digest(), fit.hexdigest(), task.given, margin, even is not None
+
+    if key(model) not in _DERIVED:
+        low, high = latent_box(model.Z_, margin)
+        settings = tuple(derive(task, model, low, high, demos, set(task.given), even))
+        _DERIVED[key(model)] = settings
+        if even is not None and any(d.key == SPACING for d in settings):
+            _DERIVED[key(even())] = settings
+    return _DERIVED[key(model)]
+
+
 _DERIVED: dict[tuple[Any, ...], tuple[Derived, ...]] = {}
-"""The derived settings per (task digest, fit, given keys, margin)."""
+"""The derived settings per (task digest, fit, given keys, margin, spacing derived)."""
 
 
 def setup(run: TrainRun, out: Path | None = None) -> Setup:
