@@ -85,7 +85,7 @@ def test_the_experiments_take_the_encoder_as_a_checked_preset_field(model):
     from latentrl.experiments.results import gplvm_info
 
     assert Exp2Preset().encoder == "gp"
-    with pytest.raises(ValueError, match="encoder: expected one of gp, projection, back_constrained, tracking, got 'pca'"):
+    with pytest.raises(ValueError, match="run: encoder: unknown variant `pca`, expected one of `gp`, `projection`, `back_constrained`, `tracking`"):
         Exp2Preset(encoder="pca").validate()
     Exp2Preset(encoder="projection").validate()
     from latentrl.experiments.exp1 import Exp1Preset

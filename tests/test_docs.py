@@ -17,6 +17,7 @@ def test_the_task_key_tables_are_the_native_schema():
     assert block.group(1).strip() == schema_markdown().strip(), (
         "docs/tasks.md is out of date: regenerate its keys with latentrl.task.schema_markdown()"
     )
+    assert "### `[run]`" in block.group(1), "docs/tasks.md lost the [run] table (trials, episodes, encoder, …)"
 
 
 # The design notes kept beside the repository (in a sibling folder), which files used to cite by

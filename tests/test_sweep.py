@@ -90,7 +90,7 @@ def test_toml_file_gives_the_python_sweep(tmp_path):
         ('experiment = "exp1"\n[grid]\nepisodes = [10, 2.5]', r"grid.episodes\[1\]: expected an integer, got 2.5"),
         ('experiment = "exp1"\n[grid.learner]\nbeta = ["hot"]', r"grid.learner.beta\[0\]: expected a number, got 'hot'"),
         ('experiment = "exp1"\n[base]\nepisodes = true', "base.episodes: expected an integer, got True"),
-        ('experiment = "exp1"\ntrials = 0', "trials: must be >= 1, got 0"),
+        ('experiment = "exp1"\ntrials = 0', r"run.trials must be an integer in \[1, 1000000\], got 0"),
         ('experiment = "exp1"\nquick = "yes"', "quick: expected true or false"),
         ('experiment = "exp1"\ntrials = 2\n[base]\ntrials = 3', "base.trials: trials is already set"),
         ('experiment = "exp1"\n[base.learner]\ngamma = 1.5', r"cell 00: learner.gamma must lie in \[0, 1\)"),

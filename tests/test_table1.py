@@ -98,7 +98,7 @@ def test_workers_do_not_change_results():
         ("constraint_test", "angle", "constraint_test"),
         ("latent_margin", -0.1, "latent_margin"),
         ("tolerance", 0.0, "tolerance"),
-        ("encoder", "nearest", "encoder: expected one of gp, projection, back_constrained"),
+        ("encoder", "nearest", "run: encoder: unknown variant `nearest`, expected one of `gp`, `projection`"),
         ("variant_margins", (0.0, float("nan")), r"variant_margins\[1\]"),
     ],
 )

@@ -60,6 +60,8 @@ def test_shipped_tasks_load_with_their_robots():
         (("max_steps = 1000", "max_steps = 0"), r"episode.max_steps must be an integer in \[1, 1000000\], got 0"),
         (('root = "fixed"', 'root = "floating"'), r"floor is required with root = \"floating\""),
         (('urdf = "../data/two_arms.urdf"', 'urdf = "../data/no_such.urdf"'), r"urdf: cannot read URDF file .*no_such.urdf"),
+        (("[learner]", "[run]\ntrials = 0\n\n[learner]"), r"task.toml: run.trials must be an integer in \[1, 1000000\], got 0"),
+        (("[learner]", '[run]\nencoder = "pca"\n\n[learner]'), r"task.toml: run.encoder \(line \d+\): unknown variant `pca`"),
     ],
 )
 def test_bad_task_files_name_the_file_the_key_and_the_rule(tmp_path, edit, message):
@@ -103,11 +105,13 @@ def test_a_task_from_a_dict_round_trips_and_its_digest_sees_changes():
 def test_the_schema_lists_every_key_with_doc_rule_kind_and_default():
     keys = {entry["key"]: entry for entry in schema()}
     for key in ("urdf", "learner.gamma", "physics.dt", "episode.start", "constraints[].kind", "obstacles[].test",
-                "fall.max_tilt", "servo.joints.NAME.kp", "target.width", "waypoint.axis"):
+                "fall.max_tilt", "servo.joints.NAME.kp", "target.width", "waypoint.axis", "run.trials", "run.encoder"):
         assert key in keys, key
         assert keys[key]["doc"], key
     assert keys["learner.gamma"]["rule"] == "must lie in [0, 1)" and keys["learner.gamma"]["default"] == 0.95
     assert keys["episode.start"]["kind"] == "uniform | demo"
+    assert keys["run.encoder"]["kind"] == "gp | projection | back_constrained | tracking"
+    assert keys["run.gplvm_max_iter"]["default"] == 1000 and keys["run.latent_margin"]["default"] == 0.1
     assert keys["physics.substeps"]["default"] == 12 and keys["physics.substeps"]["kind"] == "int"
 
 

@@ -10,7 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 from latentrl import GPLVM, PCA, LatentPolicy, Task, _reference
+from latentrl.cli import _training_run, build_parser
 from latentrl.datasets import arm_postures
+from latentrl.experiments.presets import latent_box
 from latentrl.train import train_latent_policy
 
 README = Path(__file__).resolve().parents[1] / "README.md"
@@ -186,6 +188,22 @@ def test_a_task_of_ones_own_trains(arms_model: GPLVM) -> None:
     assert policy.task.name == "mine" and policy.returns.shape == (1, 3) and policy.test_returns.shape == (1, 1)
 
 
+def test_a_task_files_run_table_sets_the_run_and_arguments_and_flags_win(arms_model: GPLVM, tmp_path: Path) -> None:
+    """`[run]` replaces the paper preset's run settings; an API argument or a flag replaces it."""
+    shipped = Task.shipped("two_arms")
+    text = (shipped.base_dir / "two_arms.toml").read_text().replace('urdf = "../data/', f'urdf = "{shipped.urdf_path.parent}/')
+    path = tmp_path / "arms.toml"
+    path.write_text(text + "\n[run]\ntrials = 1\nepisodes = 3\ntest_episodes = 0\nlatent_margin = 0.2\n")
+    task = Task.load(path)
+    policy = train_latent_policy(arms_model, task, preset="paper", episodes=2, overrides={"episode.max_steps": 20})
+    assert policy.returns.shape == (1, 2) and policy.test_returns.shape == (1, 0)
+    assert np.allclose(policy.latent_low, latent_box(arms_model.Z_, 0.2)[0])
+    args = build_parser().parse_args(["train", str(path), "--demos", "demos.csv", "--out", str(tmp_path / "out"),
+                                      "--episodes", "5", "--encoder", "gp"])
+    run = _training_run(args, {})
+    assert (run.trials, run.episodes, run.latent_margin, run.encoder, run.gplvm_max_iter) == (1, 5, 0.2, "gp", 10000)
+
+
 @pytest.mark.parametrize(
     ("kwargs", "error", "message"),
     [
@@ -193,7 +211,7 @@ def test_a_task_of_ones_own_trains(arms_model: GPLVM) -> None:
         ({"task": 3}, TypeError, "task must be a latentrl.Task"),
         ({"preset": "huge"}, ValueError, "preset must be 'quick' or 'paper'"),
         ({"episodes_per_trial": 3}, ValueError, "unknown preset fields"),
-        ({"episodes": 0}, ValueError, "episodes must be an int >= 1"),
+        ({"episodes": 0}, ValueError, r"run.episodes must be an integer in \[1, 100000000\], got 0"),
         ({"task": "humanoid_lift"}, ValueError, "humanoid_lift needs a GPLVM fitted to postures of its 19 joints"),
         ({"overrides": {"learner.alpha": 2.0}}, ValueError, r"learner.alpha must lie in \(0, 1\], got 2"),
     ],

@@ -37,6 +37,7 @@ __all__ = [
     "run_task_trials",
     "latent_survey",
     "task_schema",
+    "run_config",
     "urdf_info",
     "demo_columns",
 ]
@@ -454,6 +455,10 @@ def learner_values(
 
 def task_schema() -> list[dict[str, Any]]:
     """Every key of a task file as dicts `{key, doc, rule, kind, default}`."""
+
+def run_config(run: Mapping[str, object] | None = None) -> dict[str, Any]:
+    """The run settings `run` (a dict of `[run]` keys; defaults for the rest) checked: every
+    key's effective value, or InvalidInputError naming `run.<key>` and its rule."""
 
 def bimanual_schema() -> list[dict[str, Any]]:
     """The keys of Experiment 1's configuration (`plant.*`, `learner.*`), as `task_schema`."""

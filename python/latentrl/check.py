@@ -115,10 +115,10 @@ class CheckReport:
 def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | None = None) -> CheckReport:
     """Will `task` learn from `demos` (N, D postures in its joint order)? The findings of the
     module docs, with the settings `train` would derive where the task is silent; `model`: a
-    fitted GPLVM (default: one fitted here, d = 2, seed 0, as `train` fits); `latent_margin`: the
-    box's margin (default: `TrainPreset`'s)."""
+    fitted GPLVM (default: one fitted here, d = 2, as `train` fits); `latent_margin`: the
+    box's margin (default: the task's `[run]`, else `TrainPreset`'s)."""
     from latentrl.derive import SPACING, applied, derive
-    from latentrl.experiments.presets import latent_box
+    from latentrl.experiments.presets import latent_box, with_task_run
     from latentrl.gplvm import GPLVM
     from latentrl.train import TrainPreset
 
@@ -126,14 +126,14 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     if postures.ndim != 2 or postures.shape[1] != len(task.joint_names) or not np.isfinite(postures).all():
         raise ValueError(f"demos: expected finite postures of shape (N, {len(task.joint_names)}) for {task.name}, "
                          f"got {postures.shape}")
-    preset = TrainPreset()
+    preset = with_task_run(TrainPreset(), task)
     even: Callable[[], Any] | None = None
     if model is None:  # fitted as `latentrl train` fits, its latent spacing derived as there
 
         @cache
         def fit(spacing: str) -> GPLVM:
-            return GPLVM(n_components=2, random_state=0, max_iter=preset.gplvm_max_iter, encoder=preset.encoder,
-                         spacing=spacing).fit(postures)
+            return GPLVM(n_components=2, random_state=preset.seed, max_iter=preset.gplvm_max_iter,
+                         encoder=preset.encoder, spacing=spacing).fit(postures)
 
         model, even = fit("fit"), partial(fit, "even")
     low, high = latent_box(model.Z_, preset.latent_margin if latent_margin is None else latent_margin)

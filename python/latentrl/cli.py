@@ -20,10 +20,10 @@ from pathlib import Path
 from typing import Any
 
 from latentrl import _native
-from latentrl.experiments.presets import field_docs, with_overrides
+from latentrl.experiments.presets import field_docs, with_overrides, with_task_run
 from latentrl.lazy_parser import LazyParser
 from latentrl.run_lock import run_lock
-from latentrl.task import by_path, changed_since
+from latentrl.task import by_path, changed_since, run_default
 from latentrl.train import POLICIES, format_rollout
 
 DEMOS_HELP = ("demonstrated postures: .csv (header of joint names), .npz or .json; or a recording: a LeRobot dataset "
@@ -133,11 +133,12 @@ def _add_task_flags(
 ) -> None:
     """One `--table.key` flag per key of a task table (the native schema: one name, doc, rule and
     default per parameter), grouped by table; the default shown is `task`'s value where given (an
-    experiment's task file), else the schema's."""
+    experiment's task file), else the schema's. The `[run]` keys are the preset's fields
+    (`--trials`, `--encoder`, …)."""
     groups: dict[str, Any] = {}
     for entry in schema:
         key = entry["key"]
-        if not by_path(entry) or entry["kind"].startswith("table"):
+        if not by_path(entry) or entry["kind"].startswith("table") or key.startswith("run."):
             continue
         table, _, name = key.rpartition(".")
         group = groups.setdefault(table, parser.add_argument_group(f"[{table}] (task keys)"))
@@ -247,8 +248,9 @@ def _fit_flags(fit: argparse.ArgumentParser) -> None:
     fit.add_argument("--model", choices=("gplvm", "pca"), default="gplvm", help="the model (default: gplvm)")
     fit.add_argument("--n-components", type=_dimension, default=2,
                      help="latent dimension d, or auto (GPLVM: chosen by ARD relevance, docs/encoders.md; default: 2)")
-    fit.add_argument("--seed", type=int, default=0, help="random_state of the GPLVM (default: 0)")
-    fit.add_argument("--max-iter", type=int, default=1000, help="L-BFGS iteration cap of the GPLVM (default: 1000)")
+    seed, max_iter = run_default("seed"), run_default("gplvm_max_iter")  # the [run] table's
+    fit.add_argument("--seed", type=int, default=seed, help=f"random_state of the GPLVM (default: {seed})")
+    fit.add_argument("--max-iter", type=int, default=max_iter, help=f"L-BFGS iteration cap of the GPLVM (default: {max_iter})")
     fit.add_argument("--inducing", type=int, metavar="M", help="fit the sparse GPLVM through M inducing inputs, "
                      "for many postures (docs/method.md#sparse-gplvm; default: the exact GPLVM, at most 16384 postures)")
     fit.add_argument("--spacing", choices=("fit", "even"), default="fit",
@@ -382,14 +384,11 @@ def _interruptible(work: Callable[[], object], out: Path, resume_command: str) -
 def _train(args: argparse.Namespace) -> int:
     import matplotlib.pyplot  # noqa: F401  (the figures' [plot] extra: missing, exit 1 before any work)
 
-    from latentrl.experiments.training import TrainRun, run_training
+    from latentrl.experiments.training import run_training
 
-    base = TrainRun.quick() if args.quick else TrainRun()
-    overrides = _overrides(args, TrainRun)
     # Absolute: the run folder is read back (resume, replay, rollout) from any working directory.
-    files = {"task_file": str(args.task.resolve()), "demos": str(args.demos.resolve()),
-             "model": str(args.model.resolve()) if args.model else ""}
-    run = dataclasses.replace(with_overrides(base, overrides), **files)
+    run = _training_run(args, {"task_file": str(args.task.resolve()), "demos": str(args.demos.resolve()),
+                               "model": str(args.model.resolve()) if args.model else ""})
     meta_path = args.out / "results.json"
     if meta_path.is_file() and not args.resume:
         raise ValueError(f"{args.out} holds a run already: add --resume to continue it, or choose another --out")
@@ -408,6 +407,16 @@ def _train(args: argparse.Namespace) -> int:
         print(f"trained {run.trials} trial(s) of {run.episodes} episodes; policy in {args.out / 'policy.npz'}")
         code = _interruptible(lambda: _report_of(args.out, write=True), args.out, command)
     return code
+
+
+def _training_run(args: argparse.Namespace, files: dict[str, str]) -> Any:
+    """The `TrainRun` of `train` and `check`: the preset (`--quick` or not), the task file's
+    `[run]` where the preset holds its default, the flags, and `files`."""
+    from latentrl.experiments.training import TrainRun
+    from latentrl.task import Task
+
+    base = with_task_run(TrainRun.quick() if args.quick else TrainRun(), Task.load(args.task))
+    return dataclasses.replace(with_overrides(base, _overrides(args, TrainRun)), **files)
 
 
 def _report_of(out: Path, *, write: bool = False, as_json: bool = False) -> None:
@@ -438,12 +447,10 @@ def _check(args: argparse.Namespace) -> int:
     from latentrl.check import check_task
     from latentrl.experiments.presets import latent_box
     from latentrl.experiments.results import worker_threads
-    from latentrl.experiments.training import TrainRun, fitted
+    from latentrl.experiments.training import fitted
     from latentrl.progress import progress_bar
 
-    base = TrainRun.quick() if args.quick else TrainRun()
-    files = {"task_file": str(args.task), "demos": str(args.demos), "model": str(args.model or "")}
-    run = dataclasses.replace(with_overrides(base, _overrides(args, TrainRun)), **files)
+    run = _training_run(args, {"task_file": str(args.task), "demos": str(args.demos), "model": str(args.model or "")})
     run.validate()  # the same checks of files, keys and columns as train
     task, demos, model = fitted(run)
     low, high = latent_box(model.Z_, run.latent_margin)

@@ -27,7 +27,7 @@ from numpy.typing import NDArray
 from latentrl import _native
 from latentrl._validation import positive
 from latentrl.demos import load_demos
-from latentrl.task import Task, end_reasons
+from latentrl.task import Task, end_reasons, run_default
 
 __all__ = ["BimanualReachEnv", "LatentSpaceWrapper", "TaskEnv"]
 
@@ -318,7 +318,8 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
     space.
 
     `latent_box` = (low, high), each (d,); default: the bounding box of the GPLVM's latent
-    points `Z_` + 10 % per side (docs/method.md §RL loop), or ± 3 s.d. (`explained_variance_`) for
+    points `Z_` widened by the `[run]` table's default `latent_margin` per side (10 %;
+    docs/method.md §RL loop), or ± 3 s.d. (`explained_variance_`) for
     PCA. `max_step`: the largest latent delta per dimension; default 0.02 × the box width
     (about 0.4 RBF spacings of a 20-per-dimension grid).
     """
@@ -351,7 +352,7 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
         if latent_box is None:
             if hasattr(model, "Z_"):
                 z = np.asarray(model.Z_)
-                pad = 0.1 * (z.max(axis=0) - z.min(axis=0))
+                pad = run_default("latent_margin") * (z.max(axis=0) - z.min(axis=0))
                 low, high = z.min(axis=0) - pad, z.max(axis=0) + pad
             else:
                 sd = np.sqrt(np.asarray(model.explained_variance_))

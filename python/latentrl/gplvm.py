@@ -15,8 +15,10 @@ from latentrl._native import GpMap
 from latentrl._validation import as_matrix, int_at_least, positive
 from latentrl.pca import PCA, check_n_components
 from latentrl.spacing import SPACINGS, evenly_spaced
+from latentrl.task import encoders, run_default
 
-ENCODERS = ("gp", "projection", "back_constrained", "tracking")
+ENCODERS = encoders()
+"""The encoders (the `[run]` table's `encoder` choices; docs/encoders.md)."""
 
 #: Standard deviation of the perturbation of the (unit-scaled) PCA start for each restart.
 RESTART_SCALE = 0.5
@@ -188,12 +190,12 @@ class GPLVM(Estimator):
     def __init__(
         self,
         n_components: int | str = 2,
-        max_iter: int = 1000,
+        max_iter: int = run_default("gplvm_max_iter"),
         noise_floor: float = 1e-6,
         latent_prior: bool = False,
         n_restarts: int = 0,
         random_state: int | None = None,
-        encoder: str = "gp",
+        encoder: str = run_default("encoder"),
         tol: float = 1e-6,
         max_components: int | None = None,
         relevance_threshold: float = 0.1,

@@ -46,6 +46,30 @@ def schema() -> tuple[dict[str, Any], ...]:
     return tuple(_native.task_schema())
 
 
+@cache
+def run_settings() -> dict[str, dict[str, Any]]:
+    """The keys of the `[run]` table by name (`trials`, `encoder`, …): `{key, doc, rule, kind,
+    default}` (the native `RunConfig`: trials, episodes, seed, GPLVM fit, encoder, latent box)."""
+    return {e["key"].removeprefix("run."): e for e in schema() if e["key"].startswith("run.")}
+
+
+def run_default(name: str) -> Any:
+    """The default of the run setting `name` (`run_settings`)."""
+    return run_settings()[name]["default"]
+
+
+def encoders() -> tuple[str, ...]:
+    """The encoders a latent RL run can use (the choices of `run.encoder`; docs/encoders.md)."""
+    return tuple(run_settings()["encoder"]["kind"].split(" | "))
+
+
+def check_run(settings: Mapping[str, Any]) -> dict[str, Any]:
+    """`settings` (run settings by name, a part of them) checked by the `[run]` table's rules:
+    every run setting's effective value, or a ValueError naming `run.<key>` and its rule."""
+    checked: dict[str, Any] = _native.run_config(dict(settings))
+    return checked
+
+
 def by_path(entry: Mapping[str, Any]) -> bool:
     """Whether a schema key can be set by its dotted path (`learner.alpha`): a key of a table,
     not one of each list item (`constraints[].kind`) or of each named entry (`servo.joints.NAME.kp`)."""
@@ -152,6 +176,12 @@ class Task:
         native = _native.Task.from_dict(config, self.base_dir, name)
         return Task(native, self.base_dir, self.given | frozenset(overrides))
 
+    def run_given(self) -> dict[str, Any]:
+        """The run settings its file, dict or overrides set (`[run]`), by name; the preset of
+        a run on this task takes them (`presets.with_task_run`)."""
+        run = self.to_dict()["run"]
+        return {k: run[k] for k in (key.removeprefix("run.") for key in sorted(self.given) if key.startswith("run."))}
+
     def to_dict(self) -> dict[str, Any]:
         """Every key with its effective value: a fresh nested dict of plain values (lists, not
         tuples, so that it equals itself read back from JSON)."""
@@ -159,9 +189,12 @@ class Task:
         return config
 
     def digest(self) -> str:
-        """SHA-256 of the effective configuration and the URDF's text: what a saved policy
-        records, so that it is not run on another task."""
-        text = json.dumps(self.to_dict(), sort_keys=True, allow_nan=True)
+        """SHA-256 of the effective configuration but `[run]` (how long a run was, not what it
+        ran on) and the URDF's text: what a saved policy records, so that it is not run on
+        another task."""
+        config = self.to_dict()
+        del config["run"]
+        text = json.dumps(config, sort_keys=True, allow_nan=True)
         try:
             urdf = read_bounded(self.urdf_path, MAX_URDF_BYTES, "a URDF")
         except ValueError as err:

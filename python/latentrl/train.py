@@ -26,7 +26,7 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl._base import FORMAT_VERSION, PathLike, atomic_write, check_format, read_npz
-from latentrl.experiments.presets import LatentRun, latent_box, with_overrides
+from latentrl.experiments.presets import LatentRun, latent_box, with_overrides, with_task_run
 from latentrl.gplvm import GPLVM
 from latentrl.spacing import SPACINGS
 from latentrl.task import SHIPPED, Task, end_reasons
@@ -65,9 +65,6 @@ class TrainPreset(LatentRun):
         if self.latent_spacing == "even" and self.encoder == "back_constrained":
             raise ValueError("latent_spacing: a back-constrained GPLVM's latent points are a function of the "
                              "postures and cannot be moved; give latent_spacing 'fit' or 'auto' (which keeps them)")
-        # The trial streams take a 64-bit seed: checked here, before a folder is written (issue #38).
-        if self.seed > 2**64 - 1:
-            raise ValueError(f"seed must be an int in [0, 2**64 - 1], got {self.seed}")
 
     @classmethod
     def quick(cls) -> TrainPreset:
@@ -78,7 +75,8 @@ class TrainPreset(LatentRun):
 
 def _preset_for(task: Task | str, quick: bool, fields: Mapping[str, Any]) -> tuple[Task, Any]:
     """The task and the preset of a training run: a shipped task's name takes its experiment's
-    preset (Exp. 2, 3), a Task the `TrainPreset`; `fields` override either."""
+    preset (Exp. 2, 3), a Task the `TrainPreset`; the task's `[run]` (where the preset holds its
+    class's default), then `fields` override either."""
     if isinstance(task, str):
         if task not in SHIPPED:
             raise ValueError(f"task must be a Task or one of {list(SHIPPED)}, got {task!r}")
@@ -90,7 +88,7 @@ def _preset_for(task: Task | str, quick: bool, fields: Mapping[str, Any]) -> tup
         cls = TrainPreset
     else:
         raise TypeError(f"task must be a latentrl.Task or a shipped task's name, got {type(task).__name__}")
-    preset = with_overrides(cls.quick() if quick else cls(), fields)
+    preset = with_overrides(with_task_run(cls.quick() if quick else cls(), task), fields)
     preset.validate()
     return task.replace(preset.task), preset
 
@@ -109,8 +107,9 @@ def train_latent_policy(
     `model`, a GPLVM fitted to postures of the task's robot (columns in its joint order,
     `task.joint_names`).
 
-    `preset` is ``"quick"`` (a short budget) or ``"paper"`` (the full one); `fields` override
-    its fields by name (``trials=4, episodes=500, seed=1``), `overrides` the task's keys by path
+    `preset` is ``"quick"`` (a short budget) or ``"paper"`` (the full one); the task's `[run]`
+    table replaces the paper preset's run settings, `fields` override the result by name
+    (``trials=4, episodes=500, seed=1``), `overrides` the task's keys by path
     (``overrides={"learner.alpha": 0.5, "episode.max_steps": 200}``). `demos` (N, D): the postures a ``start = "demo"``
     task starts from (default: the model's training postures). The latent box is the bounding
     box of ``model.Z_`` widened by ``latent_margin``. Ctrl-C stops the run with

@@ -41,6 +41,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(task::latent_survey, m)?)?;
     m.add_function(wrap_pyfunction!(task::learner_values, m)?)?;
     m.add_function(wrap_pyfunction!(task::task_schema, m)?)?;
+    m.add_function(wrap_pyfunction!(task::run_config, m)?)?;
     m.add_function(wrap_pyfunction!(task::end_reasons, m)?)?;
     m.add_function(wrap_pyfunction!(urdf::urdf_info, m)?)?;
     m.add_function(wrap_pyfunction!(urdf::demo_columns, m)?)?;

@@ -6,13 +6,13 @@ use std::sync::Arc;
 
 use ::sim::task::survey::{DEFAULT_MAX_POINTS, LearnerGrid, survey};
 use ::sim::task::{SchemaTable, Task, TaskConfig, TaskPlant, TaskTrials};
-use latent_core::{EndReason, LatentPolicy, Plant, trial_rng};
+use latent_core::{EndReason, LatentPolicy, Params, Plant, RunConfig, trial_rng};
 use nalgebra::DMatrix;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::convert::{config_from, config_to, points, to_points};
+use crate::convert::{config_from, config_or_default, config_to, points, to_points};
 use crate::errors::{guard, sim_to_py, to_py};
 use crate::projection::EncoderObject;
 use crate::runner::{RunArguments, invalid, latent_args, pack_results, run_with_polling};
@@ -489,17 +489,14 @@ pub fn learner_values<'py>(
 /// Schema tables as a list of dicts `{key, doc, rule, kind, default}`, one per key.
 fn schema_list(py: Python<'_>, tables: Vec<SchemaTable>) -> PyResult<Bound<'_, PyList>> {
     let out = PyList::empty(py);
-    for table in tables {
-        let defaults = config_to(py, &table.defaults)?;
-        for e in table.entries {
-            let entry = PyDict::new(py);
-            entry.set_item("key", e.key)?;
-            entry.set_item("doc", e.doc)?;
-            entry.set_item("rule", e.rule)?;
-            entry.set_item("kind", e.kind)?;
-            entry.set_item("default", defaults.get_item(e.name).ok())?;
-            out.append(entry)?;
-        }
+    for e in tables.into_iter().flat_map(|table| table.entries) {
+        let entry = PyDict::new(py);
+        entry.set_item("key", e.key)?;
+        entry.set_item("doc", e.doc)?;
+        entry.set_item("rule", e.rule)?;
+        entry.set_item("kind", e.kind)?;
+        entry.set_item("default", config_to(py, &e.default)?)?;
+        out.append(entry)?;
     }
     Ok(out)
 }
@@ -516,6 +513,18 @@ pub fn task_schema(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
 #[pyfunction]
 pub fn bimanual_schema(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
     guard(|| schema_list(py, ::sim::bimanual::schema_tables()))
+}
+
+/// The run settings `run` (a dict of `[run]` keys; defaults for the rest) checked: every key's
+/// effective value, or InvalidInputError naming `run.<key>` and its rule.
+#[pyfunction]
+#[pyo3(signature = (run = None))]
+pub fn run_config<'py>(py: Python<'py>, run: Option<&Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyAny>> {
+    guard(|| {
+        let config: RunConfig = config_or_default("run", run)?;
+        config.check_fields("run").map_err(|e| to_py(e.into()))?;
+        config_to(py, &config)
+    })
 }
 
 /// The end reasons by code: their names in results files (0 timeout … 6 success).

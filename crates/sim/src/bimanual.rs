@@ -325,10 +325,10 @@ pub fn check_tables(plant: &BimanualConfig, learner: &LearnerConfig) -> Result<(
 /// The keys of Experiment 1's configuration (`plant.*`: the toy, `learner.*`) with their docs,
 /// rules, types and defaults.
 pub fn schema_tables() -> Vec<crate::task::SchemaTable> {
-    use crate::task::{SchemaTable, TableDefaults};
+    use crate::task::SchemaTable;
     vec![
-        SchemaTable::of::<BimanualConfig>("plant", TableDefaults::Plant(BimanualConfig::default())),
-        SchemaTable::of::<LearnerConfig>("learner", TableDefaults::Learner(LearnerConfig::default())),
+        SchemaTable::of("plant", &BimanualConfig::default()),
+        SchemaTable::of("learner", &LearnerConfig::default()),
     ]
 }
 

@@ -19,7 +19,7 @@ pub mod survey;
 pub mod trials;
 pub use config::{
     Axis, ConstraintConfig, ConstraintKind, EpisodeConfig, FallConfig, FloorConfig, ObstacleConfig, ObstacleTest,
-    RuleCheck, SchemaEntry, SchemaTable, StartRule, TableDefaults, TargetConfig, TaskConfig, TestStart, WaypointConfig,
+    RuleCheck, SchemaEntry, SchemaTable, StartRule, TargetConfig, TaskConfig, TestStart, WaypointConfig,
 };
 pub use plant::{Classified, TaskPlant};
 pub use trials::TaskTrials;

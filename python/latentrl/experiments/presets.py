@@ -2,10 +2,13 @@
 fit, overrides of the experiment's task) that each experiment's frozen dataclass extends, the
 field docs the CLI shows, and how overrides (a CLI flag, a sweep cell, a keyword) apply.
 
-A preset field is a Python-side choice (how many trials, how the GPLVM is fitted, what the
-figures draw); every task, learner and physics parameter is a key of the experiment's task
-file, overridden by key path (``task={"learner.alpha": 0.5}``, ``--learner.alpha 0.5``) and
-checked by the native side's rules.
+The run settings (trials, episodes, seed, test episodes, GPLVM iterations, encoder, latent
+margin) are the `[run]` table's keys (docs/tasks.md): their docs, defaults and rules are the
+native `RunConfig`'s, a preset states only the values it chooses, a task file's `[run]`
+replaces those (`with_task_run`) and flags replace that. The other fields are Python-side
+choices (demos, what the figures draw); every task, learner and physics parameter is a key of
+the experiment's task file, overridden by key path (``task={"learner.alpha": 0.5}``,
+``--learner.alpha 0.5``) and checked by the native side's rules.
 """
 
 from __future__ import annotations
@@ -24,25 +27,20 @@ from typing import Any
 
 import numpy as np
 
-from latentrl import _native
 from latentrl._validation import int_at_least
+from latentrl.task import Task, check_run, run_default, run_settings
 
-#: The encoders a latent RL run can use inside the native loop (GPLVM.loop_encoder_), in every
-#: experiment and `latentrl train`.
-RL_ENCODERS = ("gp", "projection", "back_constrained", "tracking")
-
-
-def check_encoder(encoder: str) -> None:
-    """ValueError naming the `encoder` field unless it is one of `RL_ENCODERS`."""
-    if encoder not in RL_ENCODERS:
-        raise ValueError(f"encoder: expected one of {', '.join(RL_ENCODERS)}, got {encoder!r}")
+def check_run_fields(preset: Any, names: tuple[str, ...]) -> None:
+    """ValueError naming `run.<name>` and its rule unless the preset's run settings `names` keep
+    the `[run]` table's rules (the one check of run settings: `latentrl.task.check_run`)."""
+    check_run({name: getattr(preset, name) for name in names})
 
 
 @cache
 def field_docs(preset_cls: type) -> dict[str, str]:
     """The attribute docstrings of a dataclass and its dataclass bases (the string literal under
-    each field; a subclass's own wins)."""
-    docs: dict[str, str] = {}
+    each field; a subclass's own wins); a run setting without one has the `[run]` key's doc."""
+    docs = {name: entry["doc"] for name, entry in run_settings().items()}
     for cls in reversed(preset_cls.__mro__):
         if not dataclasses.is_dataclass(cls):
             continue
@@ -133,20 +131,14 @@ class LatentRun:
     """What every latent-space RL experiment's preset holds: the trials, the GPLVM fit, and
     overrides of the experiment's task by key path."""
 
-    trials: int = 4
-    """Independent RL trials."""
-    episodes: int = 1000
-    """Training episodes per trial."""
-    seed: int = 0
-    """Base seed: demonstrations, GPLVM fit and every trial's RNG derive from it."""
-    test_episodes: int = 0
-    """Frozen test episodes per trial after training (no TD updates, the task's test starts); 0 = none."""
-    gplvm_max_iter: int = 1000
-    """L-BFGS iteration cap of the GPLVM fit."""
-    encoder: str = "gp"
-    """Posture → latent map of the RL loop: "gp" (the paper's out-of-sample GP onto the fitted points), "projection" (the latent point of highest density under the decoder, iterated from the nearest demo), "back_constrained" (the GPLVM fitted with Z = g(X), encoding its demos exactly) or "tracking" (the projection searched from the latent point the move commanded: a tracked posture keeps its point; docs/encoders.md)."""
-    latent_margin: float = 0.1
-    """Latent box = bounding box of the fitted latent points, widened by this share per side (ours: 10 %)."""
+    # The run settings: each one's doc, default and rule are the `[run]` table's (docs/tasks.md).
+    trials: int = run_default("trials")
+    episodes: int = run_default("episodes")
+    seed: int = run_default("seed")
+    test_episodes: int = run_default("test_episodes")
+    gplvm_max_iter: int = run_default("gplvm_max_iter")
+    encoder: str = run_default("encoder")
+    latent_margin: float = run_default("latent_margin")
     task: Mapping[str, Any] = field(default_factory=dict)
     """Overrides of the experiment's task by key path, e.g. {"learner.alpha": 0.5} (flags: --learner.alpha)."""
 
@@ -155,26 +147,33 @@ class LatentRun:
             object.__setattr__(self, "task", Overrides(self.task))
 
     def check_run(self) -> None:
-        """ValueError naming the first impossible shared field."""
-        check_ints(self, ("trials", "episodes", "gplvm_max_iter"))
-        check_ints(self, ("seed", "test_episodes"), minimum=0)
-        check_floats(self, ("latent_margin",), positive=False)
-        check_encoder(self.encoder)
-        records = self.trials * (self.episodes + self.test_episodes)
-        if records > _native.MAX_EPISODES:
-            raise ValueError(
-                f"trials × (episodes + test_episodes) = {records} episodes, more than the {_native.MAX_EPISODES} "
-                "one run holds in memory; run fewer trials or episodes"
-            )
+        """ValueError naming the first impossible shared field (a run setting: `run.<name>`)."""
+        check_run_fields(self, tuple(run_settings()))
         if not isinstance(self.task, Mapping) or not all(isinstance(k, str) and "." in k for k in self.task):
             raise ValueError(f"task: expected overrides by key path such as {{'learner.alpha': 0.5}}, got {self.task!r}")
+        run = sorted(k for k in self.task if k.startswith("run."))
+        if run:
+            raise ValueError(f"task: {', '.join(run)}: run settings are the preset's fields "
+                             f"({', '.join(k.removeprefix('run.') for k in run)}), not task overrides")
+
+
+def with_task_run(preset: Any, task: Task) -> Any:
+    """`preset` with the run settings `task` sets (its file's `[run]`, `Task.run_given`) where the
+    preset holds its class's default: a quick preset's own values win over the file, and fields
+    given later (`with_overrides`: flags, API arguments) over both."""
+    default = type(preset)()
+    given = {k: v for k, v in task.run_given().items() if getattr(preset, k) == getattr(default, k)}
+    return dataclasses.replace(preset, **given) if given else preset
 
 
 def with_overrides(preset: Any, overrides: Mapping[str, Any]) -> Any:
-    """`preset` with `overrides` applied: a preset field by its name, a task key by its path
-    (``learner.alpha``: added to the preset's `task`). An unknown field is a ValueError listing
-    the valid ones; task keys are checked by the task (`validate`)."""
+    """`preset` with `overrides` applied: a preset field by its name (a run setting also as
+    ``run.trials``), a task key by its path (``learner.alpha``: added to the preset's `task`).
+    An unknown field is a ValueError listing the valid ones; task keys are checked by the task
+    (`validate`)."""
     fields = {f.name for f in dataclasses.fields(preset)}
+    run = {f"run.{name}" for name in run_settings() if name in fields}
+    overrides = {k.removeprefix("run.") if k in run else k: v for k, v in overrides.items()}
     plain = {k: v for k, v in overrides.items() if "." not in k}
     unknown = sorted(set(plain) - fields - {"task"})
     if unknown:

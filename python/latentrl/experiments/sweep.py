@@ -51,7 +51,7 @@ from latentrl.experiments.results import RunFolder, environment, read_json, work
 from latentrl.experiments.runner import Job, Setup, run_in_process, run_rl
 from latentrl.progress import progress_bar
 from latentrl.run_lock import run_lock
-from latentrl.task import by_path, key_paths
+from latentrl.task import by_path, check_run, key_paths
 
 __all__ = ["Cell", "Sweep", "SweepError", "load_sweep", "run_sweep"]
 
@@ -112,10 +112,7 @@ class Sweep:
             known = ", ".join(rl_experiments())
             raise ValueError(f"experiment: unknown experiment {self.experiment!r}; sweeps run {known}")
         check_type("quick", self.quick, bool)
-        if self.trials is not None:
-            check_type("trials", self.trials, int, minimum=1)
-        if self.seed is not None:
-            check_type("seed", self.seed, int, minimum=0)
+        check_run({name: getattr(self, name) for name in ("trials", "seed") if getattr(self, name) is not None})
         if self.threshold is not None:
             threshold = check_type("threshold", self.threshold, float)
             if not math.isfinite(threshold):

@@ -4,7 +4,7 @@
 //! robot's links and joints are checked by [`crate::task::Task::new`]).
 
 use latent_core::params::{ParamError, Params, Rule, join};
-use latent_core::{LearnerConfig, choice, params};
+use latent_core::{LearnerConfig, RunConfig, choice, params};
 
 use crate::urdf::RootMode;
 use crate::world::{PhysicsConfig, ServoConfig};
@@ -398,6 +398,9 @@ params! {
         episode: EpisodeConfig = EpisodeConfig::default() => Rule::Nested,
         /// The learner (`[learner]`).
         learner: LearnerConfig = LearnerConfig::default() => Rule::Nested,
+        /// The run's settings (`[run]`): trials, episodes, seed, GPLVM fit, encoder, latent
+        /// box. They replace the preset's; a flag or an API argument replaces them.
+        run: RunConfig = RunConfig::default() => Rule::Nested,
     }
     check = task_rules;
 }
@@ -430,110 +433,53 @@ fn task_rules(t: &TaskConfig, path: &str) -> Result<(), ParamError> {
 }
 
 impl TaskConfig {
-    /// Every key of the task file below `path` (`""` for the top), with its doc, rule and
-    /// type: what docs/tasks.md and the CLI's flags are made from.
-    pub fn schema() -> Vec<(String, latent_core::FieldInfo)> {
-        fn add<T: Params>(prefix: &str, out: &mut Vec<(String, latent_core::FieldInfo)>) {
-            out.extend(T::fields().into_iter().map(|f| (join(prefix, f.name), f)));
-        }
-        let mut out = Vec::new();
-        add::<TaskConfig>("", &mut out);
-        add::<FloorConfig>("floor", &mut out);
-        add::<ServoConfig>("servo", &mut out);
-        add::<crate::world::JointServo>("servo.joints.NAME", &mut out);
-        add::<PhysicsConfig>("physics", &mut out);
-        add::<TargetConfig>("target", &mut out);
-        add::<ConstraintConfig>("constraints[]", &mut out);
-        add::<ObstacleConfig>("obstacles[]", &mut out);
-        add::<WaypointConfig>("waypoint", &mut out);
-        add::<FallConfig>("fall", &mut out);
-        add::<EpisodeConfig>("episode", &mut out);
-        add::<LearnerConfig>("learner", &mut out);
-        out
-    }
-
-    /// Every key of a task file with its doc, rule and type, table by table with the table's
-    /// defaults: the source of docs/tasks.md and of the CLI's flags. A key's default is its
-    /// table's: the optional and repeated tables' own, the others' as in the default task.
+    /// Every key of a task file with its doc, rule, type and default, table by table: the
+    /// source of docs/tasks.md and of the CLI's flags. A key's default is its table's: the
+    /// optional and repeated tables' own, the others' as in the default task.
     pub fn schema_tables() -> Vec<SchemaTable> {
         let top = TaskConfig::default();
-        let defaults = |prefix: &str| match prefix {
-            "floor" => TableDefaults::Floor(FloorConfig::default()),
-            "servo" => TableDefaults::Servo(top.servo.clone()),
-            "servo.joints.NAME" => TableDefaults::JointServo(crate::world::JointServo::default()),
-            "physics" => TableDefaults::Physics(top.physics.clone()),
-            "target" => TableDefaults::Target(top.target.clone()),
-            "constraints[]" => TableDefaults::Constraint(ConstraintConfig::default()),
-            "obstacles[]" => TableDefaults::Obstacle(ObstacleConfig::default()),
-            "waypoint" => TableDefaults::Waypoint(WaypointConfig::default()),
-            "fall" => TableDefaults::Fall(FallConfig::default()),
-            "episode" => TableDefaults::Episode(top.episode.clone()),
-            "learner" => TableDefaults::Learner(top.learner.clone()),
-            _ => TableDefaults::Task(Box::new(top.clone())),
-        };
-        let mut tables: Vec<SchemaTable> = Vec::new();
-        for (key, field) in TaskConfig::schema() {
-            let prefix = key.rsplit_once('.').map_or("", |(t, _)| t);
-            if tables.last().is_none_or(|t| t.prefix != prefix) {
-                tables.push(SchemaTable::new(prefix, defaults(prefix), Vec::new()));
-            }
-            tables
-                .last_mut()
-                .expect("pushed")
-                .entries
-                .push(SchemaEntry::new(key, field));
-        }
-        tables
+        vec![
+            SchemaTable::of("", &top),
+            SchemaTable::of("floor", &FloorConfig::default()),
+            SchemaTable::of("servo", &top.servo),
+            SchemaTable::of("servo.joints.NAME", &crate::world::JointServo::default()),
+            SchemaTable::of("physics", &top.physics),
+            SchemaTable::of("target", &top.target),
+            SchemaTable::of("constraints[]", &ConstraintConfig::default()),
+            SchemaTable::of("obstacles[]", &ObstacleConfig::default()),
+            SchemaTable::of("waypoint", &WaypointConfig::default()),
+            SchemaTable::of("fall", &FallConfig::default()),
+            SchemaTable::of("episode", &top.episode),
+            SchemaTable::of("learner", &top.learner),
+            SchemaTable::of("run", &top.run),
+        ]
     }
 }
 
-/// The defaults of one table of settings, serialised as the table itself.
-#[derive(Debug, Clone, serde::Serialize)]
-#[serde(untagged)]
-#[allow(missing_docs)]
-pub enum TableDefaults {
-    Task(Box<TaskConfig>),
-    Floor(FloorConfig),
-    Servo(ServoConfig),
-    JointServo(crate::world::JointServo),
-    Physics(PhysicsConfig),
-    Target(TargetConfig),
-    Constraint(ConstraintConfig),
-    Obstacle(ObstacleConfig),
-    Waypoint(WaypointConfig),
-    Fall(FallConfig),
-    Episode(EpisodeConfig),
-    Learner(LearnerConfig),
-    Plant(crate::BimanualConfig),
-}
-
-/// One table of settings: its keys and their defaults.
+/// One table of settings: its keys, each with its default.
 #[derive(Debug, Clone)]
 pub struct SchemaTable {
     /// The table's key path (`""` for the top, `constraints[]` for a repeated table).
     pub prefix: String,
-    /// The table's defaults; a key's default is the value of its `name` here (none if absent).
-    pub defaults: TableDefaults,
     /// Its keys, in declaration order.
     pub entries: Vec<SchemaEntry>,
 }
 
 impl SchemaTable {
-    /// The table at `prefix` with `defaults` and `entries`.
-    pub fn new(prefix: &str, defaults: TableDefaults, entries: Vec<SchemaEntry>) -> Self {
+    /// The table of `T`'s fields below `prefix`, each with its value in `defaults`.
+    pub fn of<T: Params + serde::Serialize>(prefix: &str, defaults: &T) -> Self {
+        let values = match toml::Value::try_from(defaults) {
+            Ok(toml::Value::Table(table)) => table,
+            _ => toml::Table::new(),
+        };
+        let entries = T::fields().into_iter().map(|f| {
+            let default = values.get(f.name).cloned();
+            SchemaEntry::new(join(prefix, f.name), f, default)
+        });
         Self {
             prefix: prefix.to_string(),
-            defaults,
-            entries,
+            entries: entries.collect(),
         }
-    }
-
-    /// The table of `T`'s fields below `prefix` (defaults `defaults`).
-    pub fn of<T: Params>(prefix: &str, defaults: TableDefaults) -> Self {
-        let entries = T::fields()
-            .into_iter()
-            .map(|f| SchemaEntry::new(join(prefix, f.name), f));
-        Self::new(prefix, defaults, entries.collect())
     }
 }
 
@@ -550,17 +496,44 @@ pub struct SchemaEntry {
     pub rule: String,
     /// Its type as the CLI names it.
     pub kind: String,
+    /// Its default as a task file writes it (none: absent by default).
+    pub default: Option<toml::Value>,
 }
 
 impl SchemaEntry {
-    /// The entry of `field` at `key`.
-    pub fn new(key: String, field: latent_core::FieldInfo) -> Self {
+    /// The entry of `field` at `key` with `default`.
+    pub fn new(key: String, field: latent_core::FieldInfo, default: Option<toml::Value>) -> Self {
         Self {
             key,
             name: field.name,
             doc: field.doc,
             rule: field.rule.to_string(),
             kind: field.kind,
+            default,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_key_carries_its_default_and_the_run_is_a_table() {
+        let tables = TaskConfig::schema_tables();
+        let entry = |key: &str| tables.iter().flat_map(|t| &t.entries).find(|e| e.key == key).cloned();
+        let default = |key: &str| entry(key).expect("a schema key").default;
+        assert_eq!(default("learner.gamma"), Some(toml::Value::Float(0.95)));
+        assert_eq!(default("run.trials"), Some(toml::Value::Integer(4)));
+        assert_eq!(default("run.encoder"), Some(toml::Value::String("gp".into())));
+        assert_eq!(default("target.relative_to"), None);
+        assert_eq!(
+            entry("run.encoder").unwrap().kind,
+            "gp | projection | back_constrained | tracking"
+        );
+        let config: TaskConfig =
+            toml::from_str("urdf = \"a.urdf\"\n[run]\nepisodes = 7\nencoder = \"tracking\"\n").unwrap();
+        assert_eq!((config.run.episodes, config.run.trials), (7, 4));
+        assert_eq!(config.run.encoder, latent_core::Encoder::Tracking);
     }
 }

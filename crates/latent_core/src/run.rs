@@ -1,0 +1,106 @@
+//! The settings of a latent RL run (a task file's `[run]` table, docs/tasks.md): how many trials
+//! of how many episodes, the seed, and how the latent space is made (the GPLVM fit, the encoder
+//! of the loop, the latent box). Each is declared once with its doc, default and rule
+//! ([`crate::params!`]); an experiment's preset sets its own values (the paper's), a task file's
+//! `[run]` overrides them and a flag or an API argument overrides that.
+//!
+//! They live here, beside the learner, because they know no plant: they size the run and make
+//! the latent space the learner acts in.
+
+use crate::params::{ParamError, Rule, join};
+use crate::trials::MAX_EPISODES;
+use crate::{choice, params};
+
+choice! {
+    /// The posture → latent map of the RL loop (docs/encoders.md).
+    pub enum Encoder {
+        /// The paper's out-of-sample GP onto the fitted latent points.
+        Gp = "gp",
+        /// The latent point of highest density under the decoder, iterated from the nearest demo.
+        Projection = "projection",
+        /// The GPLVM fitted with Z = g(X), encoding its demos exactly.
+        BackConstrained = "back_constrained",
+        /// The projection searched from the latent point the move commanded: a tracked posture
+        /// keeps its point.
+        Tracking = "tracking",
+    }
+}
+
+params! {
+    /// The settings of a latent RL run: trials, episodes, seed, GPLVM fit, encoder, latent box.
+    pub struct RunConfig {
+        /// Independent RL trials.
+        trials: usize = 4 => Rule::count(1, 1_000_000),
+        /// Training episodes per trial.
+        episodes: usize = 1000 => Rule::count(1, 100_000_000),
+        /// Base seed, an integer ≥ 0 (a task file holds up to 2⁶³ − 1): demonstrations, GPLVM
+        /// fit and every trial's RNG derive from it.
+        seed: u64 = 0 => Rule::Any,
+        /// Frozen test episodes per trial after training (no TD updates, the task's test
+        /// starts); 0 = none.
+        test_episodes: usize = 0 => Rule::count(0, 100_000_000),
+        /// Posture → latent map of the RL loop: "gp" (the paper's out-of-sample GP onto the
+        /// fitted points), "projection" (the latent point of highest density under the decoder,
+        /// iterated from the nearest demo), "back_constrained" (the GPLVM fitted with Z = g(X),
+        /// encoding its demos exactly) or "tracking" (the projection searched from the latent
+        /// point the move commanded: a tracked posture keeps its point; docs/encoders.md).
+        encoder: Encoder = Encoder::Gp => Rule::Any,
+        /// Latent box = bounding box of the fitted latent points, widened by this share of its
+        /// width per side (ours: 10 %).
+        latent_margin: f64 = 0.1 => Rule::NonNegative,
+        /// L-BFGS iteration cap of the GPLVM fit.
+        gplvm_max_iter: usize = 1000 => Rule::count(1, 1_000_000_000),
+    }
+    check = episode_records;
+}
+
+/// At most [`MAX_EPISODES`] episode records in one run (what it holds in memory).
+fn episode_records(run: &RunConfig, path: &str) -> Result<(), ParamError> {
+    let records = run.trials as u128 * (run.episodes as u128 + run.test_episodes as u128);
+    if records > MAX_EPISODES as u128 {
+        return Err(ParamError::new(
+            &join(path, "trials"),
+            format!(
+                "× (episodes + test_episodes) = {records} episodes, more than the {MAX_EPISODES} one run holds in \
+                 memory; run fewer trials or episodes"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Params;
+
+    #[test]
+    fn defaults_pass_and_errors_name_the_key() {
+        assert!(RunConfig::default().validate().is_ok());
+        let bad = |run: RunConfig| run.check_fields("run").unwrap_err().to_string();
+        assert_eq!(
+            bad(RunConfig {
+                trials: 0,
+                ..RunConfig::default()
+            }),
+            "run.trials must be an integer in [1, 1000000], got 0"
+        );
+        assert_eq!(
+            bad(RunConfig {
+                latent_margin: -0.5,
+                ..RunConfig::default()
+            }),
+            "run.latent_margin must be a finite number >= 0, got -0.5"
+        );
+        assert!(
+            bad(RunConfig {
+                trials: 1000,
+                episodes: 100_000,
+                ..RunConfig::default()
+            })
+            .starts_with("run.trials × (episodes + test_episodes) = 100000000 episodes")
+        );
+        let encoder = RunConfig::fields().into_iter().find(|f| f.name == "encoder").unwrap();
+        assert_eq!(encoder.kind, "gp | projection | back_constrained | tracking");
+    }
+}
