@@ -165,10 +165,14 @@ def test_class_1_a_gp_too_large_to_hold_is_refused_before_allocating():
 
 
 def test_class_3_a_run_too_long_to_hold_is_refused_before_allocating(tmp_path, capsys):
-    """--episodes 1e12 allocated 21.8 TiB of per-episode arrays before any check."""
+    """--episodes 1e12 allocated 21.8 TiB of per-episode arrays before any check: now past its
+    rule; 1e8 episodes (its largest) of 2 trials are more than a run holds."""
     assert cli.main([*TINY, "--episodes", "1000000000000", "--out", str(tmp_path / "run")]) == 1
     err = capsys.readouterr().err
-    assert "trials × (episodes + test_episodes) = 2000000000000 episodes, more than the 10000000" in err, err
+    assert "run.episodes must be an integer in [1, 100000000], got 1000000000000" in err, err
+    assert cli.main([*TINY, "--episodes", "100000000", "--out", str(tmp_path / "run")]) == 1
+    err = capsys.readouterr().err
+    assert "run.trials × (episodes + test_episodes) = 200000000 episodes, more than the 10000000" in err, err
     assert not (tmp_path / "run").exists()
 
 
