@@ -93,6 +93,7 @@ def test_toml_file_gives_the_python_sweep(tmp_path):
         ('experiment = "exp1"\ntrials = 0', r"run.trials must be an integer in \[1, 1000000\], got 0"),
         ('experiment = "exp1"\nquick = "yes"', "quick: expected true or false"),
         ('experiment = "exp1"\ntrials = 2\n[base]\ntrials = 3', "base.trials: trials is already set"),
+        ('experiment = "exp1"\ntrials = 2\n[base.run]\ntrials = 3', "base.run.trials: trials is already set"),
         ('experiment = "exp1"\n[base.learner]\ngamma = 1.5', r"cell 00: learner.gamma must lie in \[0, 1\)"),
         ('experiment = "exp1"\ncells = 3', "cells: expected a list of tables"),
         ('experiment = "exp1"\n[grid.learner]\nbeta = [1.0]\n[[cells]]\n"learner.beta" = 2.0', r"cells\[0\]: learner.beta also in the grid"),
@@ -130,6 +131,11 @@ def test_cells_are_the_explicit_cells_crossed_with_the_grid():
     assert cells[0].preset == expected and isinstance(cells[0].preset.task["learner.beta"], float)
     assert cells[4].preset.task["learner.beta"] == 3.0 and cells[4].preset.task["plant.max_steps"] == 80
     assert len(Sweep("exp2").expand()) == 1 and Sweep("exp2").expand()[0].id == "00"
+
+
+def test_a_run_key_by_path_sets_the_preset_field():
+    cells = Sweep("exp1", quick=True, grid={"run.episodes": [5, 6]}).expand()
+    assert [c.preset.episodes for c in cells] == [5, 6] and all("run.episodes" not in c.preset.task for c in cells)
 
 
 def test_the_example_file_describes_a_sweep():

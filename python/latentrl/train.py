@@ -47,7 +47,7 @@ class TrainPreset(LatentRun):
     (the 7-DoF arms' in 1486 and 4355 iterations, 11 and 24 s CPU), where the experiments' 1000
     stopped them unconverged."""
     encoder: str = "tracking"
-    """Posture → latent map of the RL loop (presets.LatentRun.encoder): "tracking" for a task of your own
+    """Posture → latent map of the RL loop (the `[run]` table's `encoder`): "tracking" for a task of your own
     (on the robot zoo at the default budget it matched the paper's "gp" on one robot and raised the
     greedy reach rate on two, 52 → 90 % and 22 → 46 %; docs/encoders.md)."""
     latent_spacing: str = "auto"

@@ -51,7 +51,7 @@ from latentrl.experiments.results import RunFolder, environment, read_json, work
 from latentrl.experiments.runner import Job, Setup, run_in_process, run_rl
 from latentrl.progress import progress_bar
 from latentrl.run_lock import run_lock
-from latentrl.task import by_path, check_run, key_paths
+from latentrl.task import by_path, check_run, key_paths, run_settings
 
 __all__ = ["Cell", "Sweep", "SweepError", "load_sweep", "run_sweep"]
 
@@ -122,8 +122,9 @@ class Sweep:
         kinds.update(_task_kinds(self.experiment))
         base = _check_overrides("base", key_paths(self.base), kinds)
         for name in ("trials", "seed"):
-            if getattr(self, name) is not None and name in base:
-                raise ValueError(f"base.{name}: {name} is already set at the top level of the sweep")
+            for key in (name, f"run.{name}"):
+                if getattr(self, name) is not None and key in base:
+                    raise ValueError(f"base.{key}: {name} is already set at the top level of the sweep")
         if not isinstance(self.grid, Mapping):
             raise ValueError(f"grid: expected a table of field = [values], got {self.grid!r}")
         grid: dict[str, list[Any]] = {}
@@ -229,9 +230,11 @@ def load_sweep(path: Path | str) -> Sweep:
 
 
 def _field_kinds(preset_cls: type) -> dict[str, type]:
-    """Scalar preset fields (the ones a sweep may set) → their type, from the defaults."""
+    """Scalar preset fields (the ones a sweep may set) → their type, from the defaults; a run
+    setting also by its path (`run.trials`)."""
     fields = dataclasses.fields(preset_cls)
-    return {f.name: type(f.default) for f in fields if type(f.default) in (bool, int, float, str)}
+    kinds = {f.name: type(f.default) for f in fields if type(f.default) in (bool, int, float, str)}
+    return {**kinds, **{f"run.{name}": kind for name, kind in kinds.items() if name in run_settings()}}
 
 
 def _task_kinds(experiment: str) -> dict[str, type]:
