@@ -28,7 +28,6 @@ from latentrl import _native
 from latentrl._base import FORMAT_VERSION, PathLike, atomic_write, check_format, read_npz
 from latentrl.experiments.presets import LatentRun, latent_box, with_overrides, with_task_run
 from latentrl.gplvm import GPLVM
-from latentrl.spacing import SPACINGS
 from latentrl.task import SHIPPED, Task, end_reasons
 
 
@@ -50,21 +49,10 @@ class TrainPreset(LatentRun):
     """Posture → latent map of the RL loop (the `[run]` table's `encoder`): "tracking" for a task of your own
     (on the robot zoo at the default budget it matched the paper's "gp" on one robot and raised the
     greedy reach rate on two, 52 → 90 % and 22 → 46 %; docs/encoders.md)."""
-    latent_spacing: str = "auto"
-    """The GPLVM's latent points: "fit" (the likelihood's, the paper's), "even" (moved to evenly
-    spaced ranks along each axis, θ refitted: `GPLVM.spacing`), or "auto": "even" where the fit's
-    own points leave no learner step that lands in the target region within half an episode
-    (`latentrl.derive`; on the robot zoo it let the iiwa-style arm learn, greedy reach 11 → 96 %;
-    docs/encoders.md §Latent spacing), else "fit" (always with the back-constrained encoder)."""
 
     def validate(self) -> None:
         """ValueError naming the first impossible field."""
         self.check_run()
-        if self.latent_spacing not in ("auto", *SPACINGS):
-            raise ValueError(f"latent_spacing: expected one of auto, {', '.join(SPACINGS)}, got {self.latent_spacing!r}")
-        if self.latent_spacing == "even" and self.encoder == "back_constrained":
-            raise ValueError("latent_spacing: a back-constrained GPLVM's latent points are a function of the "
-                             "postures and cannot be moved; give latent_spacing 'fit' or 'auto' (which keeps them)")
 
     @classmethod
     def quick(cls) -> TrainPreset:

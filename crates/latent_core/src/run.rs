@@ -26,6 +26,20 @@ choice! {
     }
 }
 
+choice! {
+    /// Where the GPLVM's latent points sit (docs/encoders.md §Latent spacing).
+    pub enum LatentSpacing {
+        /// "even" where a run derives its settings (`latentrl train`, `latentrl check`) and the
+        /// fit's own points leave no learner step that lands in the target region within half
+        /// an episode; else "fit" (always where a run derives nothing, as the paper's).
+        Auto = "auto",
+        /// Where the likelihood puts them (the paper's).
+        Fit = "fit",
+        /// Moved to evenly spaced ranks along each latent axis, θ refitted with them held there.
+        Even = "even",
+    }
+}
+
 params! {
     /// The settings of a latent RL run: trials, episodes, seed, GPLVM fit, encoder, latent box.
     pub struct RunConfig {
@@ -50,12 +64,25 @@ params! {
         latent_margin: f64 = 0.1 => Rule::NonNegative,
         /// L-BFGS iteration cap of the GPLVM fit.
         gplvm_max_iter: usize = 1000 => Rule::count(1, 1_000_000_000),
+        /// The GPLVM's latent points: "fit" (where the likelihood puts them, the paper's), "even"
+        /// (moved to evenly spaced ranks along each axis, θ refitted) or "auto" ("even" where a
+        /// run derives its settings and the fit's points leave no learner step that lands in the
+        /// target region within half an episode; docs/encoders.md §Latent spacing).
+        latent_spacing: LatentSpacing = LatentSpacing::Auto => Rule::Any,
     }
-    check = episode_records;
+    check = run_rules;
 }
 
-/// At most [`MAX_EPISODES`] episode records in one run (what it holds in memory).
-fn episode_records(run: &RunConfig, path: &str) -> Result<(), ParamError> {
+/// At most [`MAX_EPISODES`] episode records in one run (what it holds in memory); evenly spaced
+/// points are not a back-constrained fit's (a function of the postures).
+fn run_rules(run: &RunConfig, path: &str) -> Result<(), ParamError> {
+    if run.latent_spacing == LatentSpacing::Even && run.encoder == Encoder::BackConstrained {
+        return Err(ParamError::new(
+            &join(path, "latent_spacing"),
+            "\"even\" moves the latent points, which the back_constrained encoder's fit makes a function \
+             of the postures; give \"fit\" or \"auto\" (which keeps them) with it",
+        ));
+    }
     let records = run.trials as u128 * (run.episodes as u128 + run.test_episodes as u128);
     if records > MAX_EPISODES as u128 {
         return Err(ParamError::new(
@@ -99,6 +126,14 @@ mod tests {
                 ..RunConfig::default()
             })
             .starts_with("run.trials × (episodes + test_episodes) = 100000000 episodes")
+        );
+        assert!(
+            bad(RunConfig {
+                latent_spacing: LatentSpacing::Even,
+                encoder: Encoder::BackConstrained,
+                ..RunConfig::default()
+            })
+            .starts_with("run.latent_spacing \"even\" moves the latent points")
         );
         let encoder = RunConfig::fields().into_iter().find(|f| f.name == "encoder").unwrap();
         assert_eq!(encoder.kind, "gp | projection | back_constrained | tracking");

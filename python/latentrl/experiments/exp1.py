@@ -69,7 +69,7 @@ def fit(preset: Exp1Preset, run: Path | None = None) -> Fitted:
     def refit() -> Fitted:
         demos = bimanual_pairs(preset.n_demos, np.random.default_rng(preset.seed))
         return Fitted.of(demos, seed=preset.seed, max_iter=preset.gplvm_max_iter, margin=preset.latent_margin,
-                         encoder=preset.encoder)
+                         encoder=preset.encoder, spacing=preset.latent_spacing)
 
     return run_fit(run, preset.latent_margin, refit)
 

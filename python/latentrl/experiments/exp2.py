@@ -83,13 +83,13 @@ def fit(preset: Exp2Preset, run: Path | None = None) -> Fitted:
     run in directory `run` (`latent_runs.run_fit`). Fits are cached on the fields they depend
     on, so `setup` and `figures` (and presets that differ elsewhere) share one."""
     return run_fit(run, preset.latent_margin, lambda: _fit(
-        preset.n_demos, preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder))
+        preset.n_demos, preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder, preset.latent_spacing))
 
 
 @lru_cache(maxsize=4)
-def _fit(n_demos: int, seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
+def _fit(n_demos: int, seed: int, max_iter: int, margin: float, encoder: str, spacing: str) -> Fitted:
     demos = arm_postures(n_demos, np.random.default_rng(seed))
-    return Fitted.of(demos, seed=seed, max_iter=max_iter, margin=margin, encoder=encoder)
+    return Fitted.of(demos, seed=seed, max_iter=max_iter, margin=margin, encoder=encoder, spacing=spacing)
 
 
 def setup(preset: Exp2Preset, run: Path | None = None) -> Setup:

@@ -106,13 +106,14 @@ def fit(preset: Exp3Preset, run: Path | None = None) -> Fitted:
     """Demos, GPLVM and latent box; the saved ones of the run in directory `run`
     (`latent_runs.run_fit`). Fits are cached on the fields they depend on."""
     return run_fit(run, preset.latent_margin,
-                   lambda: _fit(preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder))
+                   lambda: _fit(preset.seed, preset.gplvm_max_iter, preset.latent_margin, preset.encoder,
+                                preset.latent_spacing))
 
 
 @lru_cache(maxsize=4)
-def _fit(seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
+def _fit(seed: int, max_iter: int, margin: float, encoder: str, spacing: str) -> Fitted:
     demos = shipped_demos("humanoid_lift")
-    return Fitted.of(demos, seed=seed, max_iter=max_iter, margin=margin, encoder=encoder)
+    return Fitted.of(demos, seed=seed, max_iter=max_iter, margin=margin, encoder=encoder, spacing=spacing)
 
 
 def setup(preset: Exp3Preset, run: Path | None = None) -> Setup:

@@ -32,9 +32,12 @@ class Fitted:
     high: NDArray[np.float64]
 
     @classmethod
-    def of(cls, demos: NDArray[np.float64], *, seed: int, max_iter: int, margin: float, encoder: str) -> Fitted:
-        """The fit of `demos` (deterministic in `seed`) and its box with `margin` per side."""
-        model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder).fit(demos)
+    def of(cls, demos: NDArray[np.float64], *, seed: int, max_iter: int, margin: float, encoder: str,
+           spacing: str) -> Fitted:
+        """The fit of `demos` (deterministic in `seed`) and its box with `margin` per side; `spacing`
+        the run's `latent_spacing` ("auto" derives nothing here: the fit's points)."""
+        model = GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder,
+                      spacing="fit" if spacing == "auto" else spacing).fit(demos)
         return cls.of_model(model, margin)
 
     @classmethod

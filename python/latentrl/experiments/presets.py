@@ -139,6 +139,7 @@ class LatentRun:
     gplvm_max_iter: int = run_default("gplvm_max_iter")
     encoder: str = run_default("encoder")
     latent_margin: float = run_default("latent_margin")
+    latent_spacing: str = run_default("latent_spacing")
     task: Mapping[str, Any] = field(default_factory=dict)
     """Overrides of the experiment's task by key path, e.g. {"learner.alpha": 0.5} (flags: --learner.alpha)."""
 
