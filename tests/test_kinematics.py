@@ -1,11 +1,13 @@
-"""The Rust planar-arm kinematics (`_native.arms_fk` / `arms_ik`) against the NumPy reference."""
+"""The Rust planar-arm kinematics (`_native.arms_fk` / `arms_ik`) and grip rule (`grip_error`)
+against the NumPy reference."""
 
 import numpy as np
 import pytest
 
 from latentrl import InvalidInputError
-from latentrl._native import arms_elbows, arms_fk, arms_ik
+from latentrl._native import arms_elbows, arms_fk, arms_ik, grip_error
 from latentrl._reference import arms_forward
+from latentrl._reference import grip_error as numpy_grip_error
 from latentrl.datasets import SHOULDERS, arm_hands
 
 
@@ -18,6 +20,15 @@ def test_fk_matches_numpy():
     q = random_postures()
     np.testing.assert_allclose(arms_fk(q), arms_forward(q), atol=1e-14)
     np.testing.assert_allclose(arms_elbows(q), arms_forward(q, elbows=True), atol=1e-14)
+
+
+@pytest.mark.parametrize("test", ["distance", "vector"])
+def test_grip_error_matches_numpy_bit_for_bit(test):
+    """Same sum order as NumPy (no `hypot`): Table I and Exp 2's counts stay the same bits."""
+    rng = np.random.default_rng(1)
+    near = np.hstack([left := rng.uniform(-1, 1, (500, 2)), left + [0.1, 0.0] + rng.normal(0, 0.01, (500, 2))])
+    for hands in (near, rng.uniform(-2, 2, (500, 4)), arms_fk(random_postures())):
+        np.testing.assert_array_equal(grip_error(hands, test), numpy_grip_error(hands, test))
 
 
 def test_known_poses():
@@ -76,6 +87,8 @@ def test_ik_angles_continuous_over_a_sweep():
             "right hand target of row 1",
         ),
         (arms_ik, np.zeros((0, 4)), "empty"),
+        (grip_error, np.zeros((2, 8)), r"hands: expected shape \(N, 4\)"),
+        (grip_error, np.array([[0.0, np.inf, 0.0, 0.0]]), "non-finite"),
     ],
 )
 def test_bad_input_raises_value_error(call, arg, message):

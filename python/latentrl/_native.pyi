@@ -31,6 +31,7 @@ __all__ = [
     "fall_check",
     "gplvm_back_constrained_nll_grad",
     "gplvm_nll_grad",
+    "grip_error",
     "latent_refusal",
     "learner_values",
     "run_bimanual_trials",
@@ -219,6 +220,10 @@ def arms_elbows(postures: NDArray[np.float64]) -> NDArray[np.float64]:
 def arms_ik(hands: NDArray[np.float64]) -> NDArray[np.float64]:
     """Postures `(N, 4)` (elbows outward, shoulder angles continuous in front of the body) that
     put the hands at `hands` `(N, 4)`; an unreachable row raises InvalidInputError."""
+
+def grip_error(hands: NDArray[np.float64], test: str = "distance") -> NDArray[np.float64]:
+    """Grip error `(N,)` in metres of hands `(N, 4)` by `test`: `"distance"`
+    `| ‖hand_R − hand_L‖ − 0.1 |` or `"vector"` `‖(hand_R − hand_L) − (0.1, 0)‖`."""
 
 def fall_check(
     task: Task,

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl._validation import as_matrix
-from latentrl.datasets import LINKS, SHOULDERS
+from latentrl.datasets import LINKS, OFFSET, SHOULDERS
 
 Array = NDArray[np.float64]
 
@@ -126,3 +126,16 @@ def arms_forward(postures: NDArray[np.float64], *, elbows: bool = False) -> NDAr
         else:
             out[:, 2 * arm], out[:, 2 * arm + 1] = ex + l2 * np.cos(q12), ey + l2 * np.sin(q12)
     return out
+
+
+def grip_error(hands: NDArray[np.float64], test: str = "distance") -> NDArray[np.float64]:
+    """NumPy grip error (N,) of hands (N, 4): `"distance"` `| ‖hand_R − hand_L‖ − ‖OFFSET‖ |`,
+    `"vector"` `‖(hand_R − hand_L) − OFFSET‖`."""
+    hands = as_matrix("hands", hands, n_cols=4)
+    diff = hands[:, 2:] - hands[:, :2]
+    error: NDArray[np.float64]
+    if test == "distance":
+        error = np.abs(np.linalg.norm(diff, axis=1) - np.linalg.norm(OFFSET))
+    else:
+        error = np.linalg.norm(diff - OFFSET, axis=1)
+    return error

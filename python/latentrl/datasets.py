@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl._native import arms_elbows, arms_fk, arms_ik
+from latentrl._native import grip_error as native_grip_error
 from latentrl._validation import as_matrix, int_at_least
 
 OFFSET = np.array([0.1, 0.0])
@@ -160,14 +161,8 @@ def grip_error(
     `"distance"`: `| ‖hand_R − hand_L‖ − 0.1 |` (the paper's Fig. 5: "distance between the
     end-effectors within 0.005 of 0.1"); `"vector"`: `‖(hand_R − hand_L) − (0.1, 0)‖`
     (Experiment 1's drop test, docs/method.md §Experiment 1, which also catches a rotated object).
+    The plant's own rule (`_native.grip_error`); `_reference.grip_error` is its NumPy oracle.
     """
-    hands = as_matrix("hands", hands, n_cols=4)
-    diff = hands[:, 2:] - hands[:, :2]
-    error: NDArray[np.float64]
-    if test == "distance":
-        error = np.abs(np.linalg.norm(diff, axis=1) - np.linalg.norm(OFFSET))
-        return error
-    if test == "vector":
-        error = np.linalg.norm(diff - OFFSET, axis=1)
-        return error
-    raise ValueError(f"test must be 'distance' or 'vector', got {test!r}")
+    hands = np.ascontiguousarray(as_matrix("hands", hands, n_cols=4))
+    error: NDArray[np.float64] = np.asarray(native_grip_error(hands, test))
+    return error

@@ -32,6 +32,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(kinematics::arms_fk, m)?)?;
     m.add_function(wrap_pyfunction!(kinematics::arms_elbows, m)?)?;
     m.add_function(wrap_pyfunction!(kinematics::arms_ik, m)?)?;
+    m.add_function(wrap_pyfunction!(kinematics::grip_error, m)?)?;
     m.add_function(wrap_pyfunction!(fallcheck::fall_check, m)?)?;
     m.add_function(wrap_pyfunction!(bimanual::run_bimanual_trials, m)?)?;
     m.add_function(wrap_pyfunction!(bimanual::bimanual_config, m)?)?;

@@ -25,6 +25,10 @@ use latent_core::{
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
+/// The held object's offset `hand_R − hand_L` in metres (paper: (0.1, 0), no rotation): the
+/// plant's default `grip` and the grip rule of [`crate::kinematics::grip_error`].
+pub const GRIP: [f64; 2] = [0.1, 0.0];
+
 params! {
     /// Everything about the Experiment 1 plant and its episodes; `Default` is
     /// docs/method.md §Experiment 1.
@@ -33,7 +37,7 @@ params! {
         /// docs/method.md §Experiment 1; Table I and the paper-strict variant: 0.005).
         drop_tolerance: f64 = 0.1 => Rule::Positive,
         /// The held object's offset x_R − x_L (paper: (0.1, 0), no rotation).
-        grip: [f64; 2] = [0.1, 0.0] => Rule::Finite,
+        grip: [f64; 2] = GRIP => Rule::Finite,
         /// Centre of the disc obstacle neither hand may enter (ours: (0.5, 0.5)).
         obstacle_centre: [f64; 2] = [0.5, 0.5] => Rule::Finite,
         /// Radius of the disc obstacle (ours: 0.2); 0 removes it.

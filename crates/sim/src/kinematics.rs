@@ -1,5 +1,6 @@
 //! Kinematics of two planar 2-link arms (docs/method.md §Experiment 2, paper Sec. IV-B, Fig. 5):
-//! forward kinematics of hands and elbows, and an analytic inverse for a pair of hand targets.
+//! forward kinematics of hands and elbows, an analytic inverse for a pair of hand targets, and
+//! the grip rule: how far a pair of hands is from holding the object ([`grip_error`]).
 //!
 //! Conventions (ours; the paper leaves them open):
 //! - A **posture** is `[q1_L, q2_L, q1_R, q2_R]` in radians: `q1` is the upper arm's angle
@@ -13,6 +14,7 @@
 //!   shoulder, so postures stay continuous (no 2π jumps) for every hand target in front of
 //!   or beside the body (docs/pitfalls.md §GP numerics, joint angles from inverse kinematics).
 
+use crate::bimanual::GRIP;
 use crate::error::{Result, SimError, check_finite};
 use latent_core::CoreError;
 
@@ -197,6 +199,53 @@ impl PlanarArms {
     }
 }
 
+/// Which distance [`grip_error`] measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GripTest {
+    /// `| ‖hand_R − hand_L‖ − ‖GRIP‖ |` (the paper's Fig. 5: "distance between the
+    /// end-effectors within 0.005 of 0.1").
+    Distance,
+    /// `‖(hand_R − hand_L) − GRIP‖` (Experiment 1's drop test, which also catches a rotated
+    /// object).
+    Vector,
+}
+
+impl std::str::FromStr for GripTest {
+    type Err = SimError;
+
+    /// `"distance"` or `"vector"`.
+    fn from_str(name: &str) -> Result<Self> {
+        match name {
+            "distance" => Ok(Self::Distance),
+            "vector" => Ok(Self::Vector),
+            _ => Err(SimError::Input(CoreError::Argument(format!(
+                "test must be 'distance' or 'vector', got {name:?}"
+            )))),
+        }
+    }
+}
+
+/// How far hands `[x_L, y_L, x_R, y_R]` are from holding the object (offset [`GRIP`]), in
+/// metres, by `test`. Summed in NumPy's order (`sqrt(dx² + dy²)`, no `hypot`), so the NumPy
+/// oracle gives the same bits.
+pub fn grip_error(hands: &[f64; 4], test: GripTest) -> f64 {
+    let norm = |x: f64, y: f64| (x * x + y * y).sqrt();
+    let (dx, dy) = (hands[2] - hands[0], hands[3] - hands[1]);
+    match test {
+        GripTest::Distance => (norm(dx, dy) - norm(GRIP[0], GRIP[1])).abs(),
+        GripTest::Vector => norm(dx - GRIP[0], dy - GRIP[1]),
+    }
+}
+
+/// [`grip_error`] of each row of a row-major `(N, 4)` batch of hands.
+pub fn grip_error_batch(hands: &[f64], test: GripTest) -> Result<Vec<f64>> {
+    check_rows("hands", hands)?;
+    Ok(hands
+        .chunks_exact(4)
+        .map(|h| grip_error(&[h[0], h[1], h[2], h[3]], test))
+        .collect())
+}
+
 /// A flat row-major `(N, 4)` array: length a multiple of 4, N ≥ 1, all finite.
 fn check_rows(what: &'static str, values: &[f64]) -> Result<()> {
     if values.is_empty() || !values.len().is_multiple_of(4) {
@@ -328,6 +377,30 @@ mod tests {
         assert!(matches!(
             bad.validate(),
             Err(SimError::Input(CoreError::InvalidParameter { name: "forearm", .. }))
+        ));
+    }
+
+    #[test]
+    fn grip_errors() {
+        let hands = [0.0, 0.0, 0.103, 0.004, 0.0, 0.0, 0.0, 0.1];
+        let vector = grip_error_batch(&hands, GripTest::Vector).unwrap();
+        assert!(close(&vector, &[0.005, 0.02_f64.sqrt()], 1e-12), "{vector:?}");
+        let distance = grip_error_batch(&hands, GripTest::Distance).unwrap();
+        assert!(
+            close(&distance, &[0.103_f64.hypot(0.004) - 0.1, 0.0], 1e-12),
+            "{distance:?}"
+        );
+        assert_eq!(
+            grip_error(&[1.0, 2.0, 1.1, 2.0], GripTest::Distance),
+            grip_error(&[1.0, 2.0, 1.0, 2.1], GripTest::Distance)
+        );
+        assert!(matches!(
+            "angle".parse::<GripTest>(),
+            Err(SimError::Input(CoreError::Argument(_)))
+        ));
+        assert!(matches!(
+            grip_error_batch(&[0.0; 3], GripTest::Vector),
+            Err(SimError::Input(CoreError::Shape { .. }))
         ));
     }
 
