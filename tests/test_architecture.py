@@ -104,3 +104,92 @@ def test_importing_latentrl_imports_no_scipy():
     code = "import sys, latentrl; print(sorted({m.split('.')[0] for m in sys.modules} & {'scipy'}))"
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=True)
     assert done.stdout.strip() == "[]"
+
+
+TASK_MATHS = {"norm", "hypot", "sqrt", "sin", "cos", "tan", "arcsin", "arccos", "arctan", "arctan2", "atan2", "cross", "dist"}
+"""Calls that kinematics, distances to a target or obstacle tests need (`np.linalg.norm`, `np.hypot`,
+`math.dist`, trigonometry, cross products); `x ** 0.5` counts as `sqrt`."""
+
+TASK_GEOMETRY = {"reach_radius", "position", "obstacles", "half_extents", "obstacle_centre", "obstacle_radius",
+                 "drop_tolerance", "floor", "constraints", "tolerance"}
+"""Task keys (subscripts or attributes) that a success, reach or collision test compares against."""
+
+NOT_TASK_RULES = {
+    ("check.py", "survey_findings"): "reads reach_radius for its message; distances and reached points "
+                                      "are the native survey's",
+    ("check.py", "encoder_finding"): "a distance in latent space (encode ∘ decode round trip), in learner steps",
+    ("datasets.py", "arm_hands"): "the demo generator's sampling region (shoulder→hand distance), which the plant "
+                                  "never applies",
+    ("envs.py", "LatentSpaceWrapper.__init__"): "a PCA model's default latent box, ±3 s.d. of its components",
+    ("gplvm.py", "GPLVM.fit"): "the PCA initialisation scaled by its first s.d.",
+    ("physics_check.py", "servo_error"): "the servos' tracking error against the rest poses",
+    ("physics_check.py", "physics_error"): "the distance between two physics settings' tracks, against the "
+                                           "task's physics.tolerance",
+    ("render.py", "<module>"): "the unit ring the renderer draws",
+    ("render.py", "draw_room_3d"): "obstacles and floor clipped to the drawn view",
+    ("experiments/fallcheck.py", "_rms_max"): "RMS and max tracking error of the fall check's joints",
+    ("experiments/table1.py", "_evaluate"): "Table I's reconstruction RMS and the share of native grip errors "
+                                            "within the table's tolerance",
+}
+"""Functions that use `TASK_MATHS`, or read `TASK_GEOMETRY` and compare, for something that is not a
+task rule: each says what it computes instead."""
+
+
+def scoped_nodes(tree: ast.AST) -> dict[str, list[ast.AST]]:
+    """Innermost function or class ("Class.method", "<module>") → the nodes written in its body."""
+    scopes: dict[str, list[ast.AST]] = {}
+
+    def walk(node: ast.AST, scope: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            inner = scope
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                inner = f"{scope}.{child.name}" if scope != "<module>" else child.name
+            scopes.setdefault(inner, []).append(child)
+            walk(child, inner)
+
+    walk(tree, "<module>")
+    return scopes
+
+
+def task_rule_suspects(package: Path = PACKAGE) -> dict[tuple[str, str], str]:
+    """(module path, function) → what it does that task rules need: a `TASK_MATHS` call, or a
+    `TASK_GEOMETRY` read in a function that also compares with <, <=, > or >= (`_reference.py`, the
+    NumPy oracle of the native rules, left out)."""
+    order = (ast.Lt, ast.LtE, ast.Gt, ast.GtE)
+    found: dict[tuple[str, str], str] = {}
+    for path in sorted(package.rglob("*.py")):
+        if path.name == "_reference.py":
+            continue
+        for scope, nodes in scoped_nodes(ast.parse(path.read_text())).items():
+            maths, keys, compares = set(), set(), False
+            for node in nodes:
+                if isinstance(node, ast.Call):
+                    func = node.func
+                    name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", None)
+                    maths |= {name} & TASK_MATHS
+                elif isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
+                    if isinstance(node.right, ast.Constant) and node.right.value == 0.5:
+                        maths.add("sqrt")
+                elif isinstance(node, ast.Subscript) and isinstance(node.slice, ast.Constant):
+                    keys |= {node.slice.value} & TASK_GEOMETRY
+                elif isinstance(node, ast.Attribute):
+                    keys |= {node.attr} & TASK_GEOMETRY
+                elif isinstance(node, ast.Compare):
+                    compares |= any(isinstance(op, order) for op in node.ops)
+            if maths or (keys and compares):
+                uses = sorted(maths) + ([f"compares {sorted(keys)}"] if keys and compares else [])
+                found[(path.relative_to(package).as_posix(), scope)] = ", ".join(uses)
+    return found
+
+
+def test_task_rules_only_in_rust():
+    """Issue #39, item 3: kinematics, success, distances to targets and obstacle geometry are asked
+    of the native task (`TaskPlant`, `latent_survey`, `arms_fk`, `grip_error`), not recomputed.
+    An AST scan cannot prove it; it catches the operations such code needs, outside a short list
+    of functions that use them for something else."""
+    suspects = task_rule_suspects()
+    unexplained = {where: uses for where, uses in suspects.items() if where not in NOT_TASK_RULES}
+    assert not unexplained, f"task rules computed in Python (ask the native task, or explain in NOT_TASK_RULES): " \
+                            f"{unexplained}"
+    stale = sorted(set(NOT_TASK_RULES) - set(suspects))
+    assert not stale, f"NOT_TASK_RULES entries that no longer use task maths: {stale}"

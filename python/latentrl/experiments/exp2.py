@@ -149,19 +149,22 @@ def _latent_panel(
 ) -> None:
     """`plots.latent_value_panel` with the task's rules mapped into latent space by the native
     plant: black where the decoded hands are in a wall, red lines around the postures that break
-    the grip, dashed white around the target region."""
+    the grip, dashed white around the target region (the points `latentrl check`'s survey finds
+    reached at rest)."""
+    from latentrl.derive import survey_at_step
     from latentrl.plots import latent_value_panel
 
     plant = task.plant(fitted.demos)
-    reach = task.to_dict()["target"]["reach_radius"]
 
     def regions(ax: Axes, g0: NDArray[np.float64], g1: NDArray[np.float64], postures: NDArray[np.float64]) -> None:
-        codes, effectors, targets = plant.classify(np.clip(postures, task.lower, task.upper))
-        codes = codes.reshape(g0.shape)
+        codes = plant.classify(np.clip(postures, task.lower, task.upper))[0].reshape(g0.shape)
         ax.contourf(g0, g1, (codes == 1).astype(float), levels=[0.5, 1.5], colors="k")
         ax.contour(g0, g1, (codes == 3).astype(float), levels=[0.5], colors="r", linewidths=1)
-        rms = np.sqrt(((effectors - targets) ** 2).sum(axis=1) / 2).reshape(g0.shape)
-        ax.contour(g0, g1, rms, levels=[reach], colors="w", linestyles="--", linewidths=1)
+        survey = survey_at_step(task, fitted.model, fitted.low, fitted.high, fitted.demos)
+        if survey["reached"].any():
+            z0, z1 = survey["points"].T
+            ax.tricontour(z0, z1, survey["reached"].astype(float), levels=[0.5], colors="w", linestyles="--",
+                          linewidths=1)
 
     latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, learner=learner, regions=regions, grid=grid)
 

@@ -245,8 +245,9 @@ def _latent_panel(
     """`plots.latent_value_panel` on a `map_grid` grid with the decoded postures (clipped to the
     joint limits) that, standing at rest, break a rule of the task (the native plant's
     `classify`): touch the obstacle (black), fall (grey) or break the grip (red); and the target
-    region (dashed white: RMS per-hand distance to h* ≤ 2 reach radii, standing). `maps` caches
-    the classification between the panels."""
+    region (dashed white: the admissible points of the native survey within 2 reach radii of h*,
+    standing). `maps` caches the classification and the survey between the panels."""
+    from latentrl.derive import survey_at_step
     from latentrl.plots import latent_value_panel
 
     config = task.to_dict()
@@ -254,14 +255,16 @@ def _latent_panel(
     def regions(ax: Axes, g0: NDArray[np.float64], g1: NDArray[np.float64], postures: NDArray[np.float64]) -> None:
         if "rest" not in maps:
             plant = task.plant(fitted.demos)
-            maps["rest"], maps["hands"], maps["targets"] = plant.classify(np.clip(postures, task.lower, task.upper))
-        rest, hands = maps["rest"].reshape(g0.shape), maps["hands"]
+            maps["rest"] = plant.classify(np.clip(postures, task.lower, task.upper))[0]
+            maps["survey"] = survey_at_step(task, fitted.model, fitted.low, fitted.high, fitted.demos)
+        rest, survey = maps["rest"].reshape(g0.shape), maps["survey"]
         for code, colour in ((1, "k"), (4, "0.6"), (3, "tab:red")):
             if (rest == code).any():
                 ax.contourf(g0, g1, (rest == code).astype(float), levels=[0.5, 1.5], colors=colour, alpha=0.8)
-        rms = np.sqrt(((hands - maps["targets"]) ** 2).sum(axis=1) / 2).reshape(g0.shape)
-        reach = config["target"]["reach_radius"]
-        ax.contour(g0, g1, rms, levels=[2 * reach], colors="w", linestyles="--", linewidths=1)
+        near = 2 * config["target"]["reach_radius"]  # a wider ring than success's: standing at rest
+        distance = np.where(survey["codes"] == 0, survey["distance"], survey["distance"].max())  # admissible only
+        z0, z1 = survey["points"].T
+        ax.tricontour(z0, z1, distance, levels=[near], colors="w", linestyles="--", linewidths=1)
 
     latent_value_panel(ax, weights, fitted.low, fitted.high, fitted.model, learner=config["learner"], regions=regions,
                        grid=preset.map_grid)
