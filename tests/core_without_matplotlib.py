@@ -27,7 +27,7 @@ def main() -> None:
     from latentrl import GPLVM, Demonstrations, Task, save_demos
     from latentrl.cli import main as cli
     from latentrl.datasets import arm_postures
-    from latentrl.train import train_latent_policy
+    from latentrl import train_latent_policy
 
     model = GPLVM(n_components=2, max_iter=20, random_state=0).fit(arm_postures(30, np.random.default_rng(0)))
     policy = train_latent_policy(

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from latentrl.experiments.presets import with_overrides
+from latentrl.run_settings import with_overrides
 
 CONTROL_ALPHA = 1e-12
 """α of the non-learning control."""

@@ -193,3 +193,41 @@ def test_task_rules_only_in_rust():
                             f"{unexplained}"
     stale = sorted(set(NOT_TASK_RULES) - set(suspects))
     assert not stale, f"NOT_TASK_RULES entries that no longer use task maths: {stale}"
+
+
+ABOVE_EXPERIMENTS = {
+    "latentrl": "re-exports `train_latent_policy` (documented as `latentrl.train_latent_policy`), which lives with "
+                "its experiment, loaded when first asked for (`__getattr__`)",
+    "latentrl.__main__": "`python -m latentrl`: the command",
+    "latentrl.cli": "the `latentrl` command: dispatches to the experiments by name through the registry, and runs "
+                    "`train`, `rollout`, `report`, `plot`, `sweep` on their run folders",
+    "latentrl.replay": "`latentrl replay`: videos of a run folder's episodes, as the experiment that wrote it stored them",
+}
+"""The modules above the experiments (the command and the package root's lazy re-export): the only
+ones outside `latentrl.experiments` that may import it."""
+
+
+def test_imports_point_from_experiments_to_the_public_api():
+    """Issue #39, item 4: commands → experiments → public API → `_native`. No public module imports
+    an experiment or a command, no experiment imports a command; lazy imports count (an import
+    inside a function is still a dependency). Circles: `test_no_module_imports_itself_through_others`."""
+    graph = imports()
+    assert set(ABOVE_EXPERIMENTS) <= set(graph), f"ABOVE_EXPERIMENTS names modules that do not exist: {set(ABOVE_EXPERIMENTS) - set(graph)}"
+
+    def layer(module: str) -> int:
+        return 2 if module in ABOVE_EXPERIMENTS else 1 if module.startswith("latentrl.experiments") else 0
+
+    upward = {
+        module: sorted(t for t in targets if layer(t) > layer(module))
+        for module, targets in graph.items()
+        if any(layer(t) > layer(module) for t in targets)
+    }
+    assert not upward, f"modules that import a layer above their own: {upward}"
+    root = sorted(t for t in graph["latentrl"] if layer(t) == 1)
+    assert root == ["latentrl.experiments.training"], f"the package root imports experiments: {root}"
+
+
+def test_experiments_stay_at_most_13_modules():
+    """Issue #39, item 4: the orchestration layer is small enough to read (it had 20 modules)."""
+    modules = sorted(p.name for p in (PACKAGE / "experiments").glob("*.py"))
+    assert len(modules) <= 13, modules

@@ -16,7 +16,7 @@ from latentrl import Task, cli
 from latentrl.demos import Demonstrations, save_demos
 from latentrl.envs import shipped_demos
 from latentrl.experiments.exp2 import Exp2Preset
-from latentrl.experiments.presets import with_overrides
+from latentrl.run_settings import with_overrides
 from latentrl.task import schema
 
 SHIPPED_TABLES = {"floor": "humanoid_lift", "fall": "humanoid_lift"}

@@ -122,7 +122,7 @@ def test_settings_are_derived_where_the_task_is_silent(glass):
     import tomllib
 
     from latentrl.derive import derive
-    from latentrl.experiments.presets import latent_box
+    from latentrl.run_settings import latent_box
 
     task, demos, model = glass
     low, high = latent_box(model.Z_, 0.1)
@@ -227,7 +227,7 @@ def test_a_coarsened_grid_still_measures_the_target_region_at_the_learner_step(g
     of the target. Looked into again at the learner's step, the region and the closest point
     match the full grid's."""
     from latentrl import _native
-    from latentrl.experiments.presets import latent_box
+    from latentrl.run_settings import latent_box
 
     task, demos, model = glass
     task = task.replace({"learner.step": 0.25, "target.reach_radius": 0.01})

@@ -325,7 +325,7 @@ def test_fit_reports_bad_demonstration_files(tmp_path):
 def test_plot_redraws_the_finished_trials_of_a_partial_run(tmp_path):
     from latentrl.experiments.exp1 import Exp1Preset
     from latentrl.experiments import run_experiment
-    from latentrl.experiments.presets import with_overrides
+    from latentrl.run_settings import with_overrides
     from latentrl.experiments.results import RunFolder, finished_trials, write_npz
 
     run_experiment("exp1", with_overrides(Exp1Preset.quick(), {"trials": 2, "episodes": 5, "plant.max_steps": 20}),

@@ -10,7 +10,7 @@ import pytest
 from latentrl.experiments import exp1
 from latentrl.experiments.exp1 import Exp1Preset
 from latentrl.experiments import run_experiment
-from latentrl.experiments.presets import with_overrides
+from latentrl.run_settings import with_overrides
 from latentrl.experiments.runner import run_rl
 from learning import assert_separated, control
 

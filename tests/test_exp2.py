@@ -15,7 +15,7 @@ from latentrl._native import GpMap, InvalidInputError, run_task_trials
 from latentrl.experiments import exp2
 from latentrl.experiments.exp2 import Exp2Preset
 from latentrl.experiments import run_experiment
-from latentrl.experiments.presets import with_overrides
+from latentrl.run_settings import with_overrides
 from latentrl.experiments.results import write_npz
 from learning import assert_separated, control
 

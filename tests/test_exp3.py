@@ -15,7 +15,7 @@ from latentrl.cli import saved_run
 from latentrl.experiments import exp3
 from latentrl.experiments.exp3 import Exp3Preset
 from latentrl.experiments import run_experiment
-from latentrl.experiments.presets import with_overrides
+from latentrl.run_settings import with_overrides
 from latentrl.experiments.results import write_npz
 from learning import assert_separated, control
 

@@ -16,7 +16,7 @@ import pytest
 from latentrl import GPLVM, LatentPolicy
 from latentrl.datasets import arm_postures
 from latentrl.replay import check_replay_arrays, rollout_episode
-from latentrl.train import train_latent_policy
+from latentrl import train_latent_policy
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
 

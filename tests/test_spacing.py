@@ -7,7 +7,7 @@ from scipy.spatial import cKDTree
 from latentrl import GPLVM
 from latentrl._native import gplvm_nll_grad
 from latentrl.spacing import even_ranks
-from latentrl.train import TrainPreset
+from latentrl.run_settings import TrainPreset
 
 
 def clustered(seed: int = 0) -> np.ndarray:

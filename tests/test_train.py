@@ -12,8 +12,8 @@ import pytest
 from latentrl import GPLVM, PCA, LatentPolicy, Task, _reference
 from latentrl.cli import _training_run, build_parser
 from latentrl.datasets import arm_postures
-from latentrl.experiments.presets import latent_box
-from latentrl.train import train_latent_policy
+from latentrl import train_latent_policy
+from latentrl.run_settings import latent_box
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 

@@ -7,7 +7,7 @@ import pytest
 
 from latentrl import GPLVM, _native, _reference
 from latentrl.datasets import arm_postures
-from latentrl.train import train_latent_policy
+from latentrl import train_latent_policy
 
 
 @pytest.fixture(scope="module", params=[1, 2, 3], ids=["d1", "d2", "d3"])

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 import numpy as np
 from latentrl.experiments import exp3
-from latentrl.experiments.presets import with_overrides
+from latentrl.run_settings import with_overrides
 from latentrl.experiments import run_experiment
 
 demos, out, which = sys.argv[1], sys.argv[2], sys.argv[3]

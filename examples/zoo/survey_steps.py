@@ -12,8 +12,7 @@ from pathlib import Path
 
 from latentrl import GPLVM, Task, load_demos
 from latentrl.derive import STEPS, applied, moves95, region_span, servo_gains, survey_at_step
-from latentrl.experiments.presets import latent_box
-from latentrl.train import TrainPreset
+from latentrl.run_settings import TrainPreset, latent_box
 
 HERE = Path(__file__).resolve().parent
 

@@ -1,6 +1,7 @@
 """latentrl: reinforcement learning in the latent space of demonstrated postures."""
 
 import sys as _sys
+from typing import TYPE_CHECKING as _TYPE_CHECKING, Any as _Any
 
 
 def _started_as_cli() -> bool:
@@ -24,7 +25,7 @@ try:
     from latentrl.gplvm import GPLVM
     from latentrl.pca import PCA
     from latentrl.task import Task
-    from latentrl.train import LatentPolicy, train_latent_policy
+    from latentrl.train import LatentPolicy
 
     import latentrl.envs  # noqa: F401  (registers the Gymnasium environments, as ale_py does)
 except BaseException as err:
@@ -35,6 +36,20 @@ except BaseException as err:
         print("latentrl: interrupted; nothing was written", file=_sys.stderr)
         raise SystemExit(130) from None
     raise
+
+if _TYPE_CHECKING:
+    from latentrl.experiments.training import train_latent_policy
+
+
+def __getattr__(name: str) -> _Any:
+    """`train_latent_policy`, `latentrl train`'s run in memory, loaded when first asked for: it
+    lives with its experiment, and no public module imports the experiments (ARCHITECTURE.md)."""
+    if name == "train_latent_policy":
+        from latentrl.experiments.training import train_latent_policy
+
+        return train_latent_policy
+    raise AttributeError(f"module 'latentrl' has no attribute {name!r}")
+
 
 __all__ = [
     "GPLVM",

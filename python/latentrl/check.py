@@ -118,9 +118,8 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     fitted GPLVM (default: one fitted here, d = 2, as `train` fits); `latent_margin`: the
     box's margin (default: the task's `[run]`, else `TrainPreset`'s)."""
     from latentrl.derive import SPACING, applied, derive
-    from latentrl.experiments.presets import latent_box, with_task_run
     from latentrl.gplvm import GPLVM
-    from latentrl.train import TrainPreset
+    from latentrl.run_settings import TrainPreset, latent_box, with_task_run
 
     postures = np.ascontiguousarray(demos, dtype=np.float64)
     if postures.ndim != 2 or postures.shape[1] != len(task.joint_names) or not np.isfinite(postures).all():

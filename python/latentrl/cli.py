@@ -20,7 +20,8 @@ from pathlib import Path
 from typing import Any
 
 from latentrl import _native
-from latentrl.experiments.presets import field_docs, with_overrides, with_task_run
+from latentrl.experiments.presets import field_docs
+from latentrl.run_settings import with_overrides, with_task_run
 from latentrl.lazy_parser import LazyParser
 from latentrl.run_lock import run_lock
 from latentrl.task import by_path, changed_since, run_default
@@ -445,7 +446,7 @@ def _report(args: argparse.Namespace) -> int:
 
 def _check(args: argparse.Namespace) -> int:
     from latentrl.check import check_task
-    from latentrl.experiments.presets import latent_box
+    from latentrl.run_settings import latent_box
     from latentrl.experiments.results import worker_threads
     from latentrl.experiments.training import fitted
     from latentrl.progress import progress_bar

@@ -213,7 +213,7 @@ def run_setup(experiment: str, preset: Any, run_dir: Path) -> tuple[Any, Any, tu
     """The task, the GPLVM and the latent box of the run in `run_dir`, as it was trained (its
     saved GPLVM: `latent_runs.run_fit`)."""
     if experiment == "train":
-        from latentrl.experiments.presets import latent_box
+        from latentrl.run_settings import latent_box
         from latentrl.experiments.training import fitted
 
         task, _, model = fitted(preset, run_dir)

@@ -1,23 +1,20 @@
-"""Train a latent-space TD(0) policy (docs/method.md §RL loop) on any task from your own fitted
-GPLVM, save it, load it and run it.
+"""A trained latent-space TD(0) policy (docs/method.md §RL loop): act, values, roll out, save
+and load.
 
-    task = Task.load("my_robot.toml")
     policy = train_latent_policy(model, task, demos=postures, trials=2, episodes=300)
     policy.save("runs/my_robot/policy.npz")
     target = LatentPolicy.load("runs/my_robot/policy.npz").act(posture)   # next servo target
 
-Every step runs in Rust: decode the latent target with the GPLVM's GP, track it with the
-simulated servos for one RL step, encode the reached posture, update V; trials run in parallel
-with the GIL released. The shipped tasks' names ("two_arms", "humanoid_lift") are shortcuts
-that use Experiment 2's and 3's presets.
+`train_latent_policy` (`latentrl.train_latent_policy`) assembles the training run; it is
+`latentrl train`'s experiment and lives with it (`latentrl.experiments.training`). Every step runs
+in Rust: decode the latent target with the GPLVM's GP, track it with the simulated servos for one
+RL step, encode the reached posture, update V.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -26,113 +23,8 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl._base import FORMAT_VERSION, PathLike, atomic_write, check_format, read_npz
-from latentrl.experiments.presets import LatentRun, latent_box, with_overrides, with_task_run
 from latentrl.gplvm import GPLVM
-from latentrl.task import SHIPPED, Task, end_reasons
-
-
-@dataclass(frozen=True)
-class TrainPreset(LatentRun):
-    """Training a latent policy on a task of your own (`latentrl train`)."""
-
-    trials: int = 4
-    """Independent RL trials; the policy keeps each trial's weights (ours: 4)."""
-    episodes: int = 2000
-    """Training episodes per trial (ours: 2000)."""
-    test_episodes: int = 20
-    """Frozen test episodes per trial after training (no TD updates, the task's test starts; ours: 20)."""
-    gplvm_max_iter: int = 10000
-    """Iterations of the GPLVM fit, a guard, not a budget: the robot zoo's fits converge within it
-    (the 7-DoF arms' in 1486 and 4355 iterations, 11 and 24 s CPU), where the experiments' 1000
-    stopped them unconverged."""
-    encoder: str = "tracking"
-    """Posture → latent map of the RL loop (the `[run]` table's `encoder`): "tracking" for a task of your own
-    (on the robot zoo at the default budget it matched the paper's "gp" on one robot and raised the
-    greedy reach rate on two, 52 → 90 % and 22 → 46 %; docs/encoders.md)."""
-
-    def validate(self) -> None:
-        """ValueError naming the first impossible field."""
-        self.check_run()
-
-    @classmethod
-    def quick(cls) -> TrainPreset:
-        """A short run to see that it learns: 2 trials × 300 episodes, 10 test episodes (the
-        learner's step and w₀ are derived where the task is silent: `latentrl.derive`)."""
-        return dataclasses.replace(cls(), trials=2, episodes=300, test_episodes=10)
-
-
-def _preset_for(task: Task | str, quick: bool, fields: Mapping[str, Any]) -> tuple[Task, Any]:
-    """The task and the preset of a training run: a shipped task's name takes its experiment's
-    preset (Exp. 2, 3), a Task the `TrainPreset`; the task's `[run]` (where the preset holds its
-    class's default), then `fields` override either."""
-    if isinstance(task, str):
-        if task not in SHIPPED:
-            raise ValueError(f"task must be a Task or one of {list(SHIPPED)}, got {task!r}")
-        from latentrl.experiments import exp2, exp3
-
-        cls: Any = {"two_arms": exp2.Exp2Preset, "humanoid_lift": exp3.Exp3Preset}[task]
-        task = Task.shipped(task)
-    elif isinstance(task, Task):
-        cls = TrainPreset
-    else:
-        raise TypeError(f"task must be a latentrl.Task or a shipped task's name, got {type(task).__name__}")
-    preset = with_overrides(with_task_run(cls.quick() if quick else cls(), task), fields)
-    preset.validate()
-    return task.replace(preset.task), preset
-
-
-def train_latent_policy(
-    model: GPLVM,
-    task: Task | str = "two_arms",
-    *,
-    demos: Any = None,
-    preset: str = "quick",
-    progress: bool = False,
-    overrides: Mapping[str, Any] | None = None,
-    **fields: Any,
-) -> LatentPolicy:
-    """Trains the latent TD(0) learner of `task` through the physics sim in the latent space of
-    `model`, a GPLVM fitted to postures of the task's robot (columns in its joint order,
-    `task.joint_names`).
-
-    `preset` is ``"quick"`` (a short budget) or ``"paper"`` (the full one); the task's `[run]`
-    table replaces the paper preset's run settings, `fields` override the result by name
-    (``trials=4, episodes=500, seed=1``), `overrides` the task's keys by path
-    (``overrides={"learner.alpha": 0.5, "episode.max_steps": 200}``). `demos` (N, D): the postures a ``start = "demo"``
-    task starts from (default: the model's training postures). The latent box is the bounding
-    box of ``model.Z_`` widened by ``latent_margin``. Ctrl-C stops the run with
-    `KeyboardInterrupt`.
-    """
-    from latentrl.experiments.latent_runs import task_learner  # the runner and tqdm: at the first run
-    from latentrl.experiments.runner import Setup, episodes_per_trial, run_in_process
-    from latentrl.progress import progress_bar
-
-    if preset not in ("quick", "paper"):
-        raise ValueError(f"preset must be 'quick' or 'paper', got {preset!r}")
-    if not isinstance(model, GPLVM) or not hasattr(model, "decoder_"):
-        raise TypeError(f"model must be a fitted latentrl.GPLVM, got {model!r}")
-    task, chosen = _preset_for(task, preset == "quick", {**fields, **(overrides or {})})
-    if model.n_features_in_ != len(task.joint_names):
-        raise ValueError(
-            f"{task.name} needs a GPLVM fitted to postures of its {len(task.joint_names)} joints "
-            f"{list(task.joint_names)}; got n_features_in_={model.n_features_in_}"
-        )
-    starts = np.asarray(model.X_train_ if demos is None else demos, dtype=np.float64)
-    low, high = latent_box(model.Z_, chosen.latent_margin)
-    if isinstance(chosen, TrainPreset):  # a Task of yours (not a shipped experiment): derive what it leaves open
-        from latentrl.derive import applied, derive
-
-        task = applied(task, derive(task, model, low, high, starts, set(task.given)))
-    learner = task_learner(
-        task, model, (low, high), starts, episodes=chosen.episodes, seed=chosen.seed, test_episodes=chosen.test_episodes
-    )
-    built = Setup(learners={"latent": learner})
-    with progress_bar(total=chosen.trials * episodes_per_trial(chosen), unit="ep", desc="episodes", disable=not progress) as bar:
-        *_, result = next(iter(run_in_process(built, [("latent", 0, chosen.trials)], bar.update)))
-    return LatentPolicy(
-        task=task, model=model, demos=starts, latent_low=low, latent_high=high, weights=np.asarray(result["weights"]),
-        preset=chosen, record={k: np.asarray(result[k]) for k in RECORD},
-    )
+from latentrl.task import Task, end_counts, end_reasons
 
 
 POLICIES = ("greedy", "softmax", "random")
@@ -143,8 +35,6 @@ def rollout_summary(ends: NDArray[Any], reached: NDArray[Any], returns: NDArray[
     """What rollout episodes of `task` did: "success" (the share that ended as the task's
     success, `target.hold_steps`; None where the task has no such rule), "reached_any_step" (the
     share within the reach radius after some step), the count of each ending, the mean return."""
-    from latentrl.experiments.runner import end_counts
-
     rule = task.to_dict()["target"]["hold_steps"] > 0
     return {
         "success": float((ends == end_reasons().index("success")).mean()) if rule else None,

@@ -24,8 +24,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl.experiments.runner import end_counts
-from latentrl.task import end_reasons
+from latentrl.task import end_counts, end_reasons
 from latentrl.train import format_rollout
 
 LEARNT = 0.8

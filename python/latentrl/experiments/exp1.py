@@ -23,7 +23,7 @@ import numpy as np
 from latentrl import _native
 from latentrl.datasets import bimanual_pairs
 from latentrl.experiments.latent_runs import Fitted, recorded_episodes, run_fit
-from latentrl.experiments.presets import LatentRun, check_ints
+from latentrl.run_settings import LatentRun, check_ints
 from latentrl.experiments.results import gplvm_info
 from latentrl.experiments.runner import RunTrials, Setup
 

@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from latentrl._native import arms_fk
 from latentrl.datasets import arm_postures, grip_error
 from latentrl.experiments.latent_runs import Fitted, latent_setup, recorded_episodes, run_fit
-from latentrl.experiments.presets import LatentRun, check_ints, latent_box
+from latentrl.run_settings import LatentRun, check_ints, latent_box
 from latentrl.pca import PCA
 from latentrl.experiments.runner import Setup
 from latentrl.task import Task

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from latentrl import _native
 from latentrl.envs import shipped_demos
 from latentrl.experiments.latent_runs import Fitted, latent_setup, run_fit
-from latentrl.experiments.presets import LatentRun, check_ints
+from latentrl.run_settings import LatentRun, check_ints
 from latentrl.experiments.runner import Setup
 from latentrl.task import Task
 

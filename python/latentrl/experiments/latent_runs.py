@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl import _native
-from latentrl.experiments.presets import latent_box
+from latentrl.run_settings import latent_box
 from latentrl.experiments.results import RunFolder, gplvm_info
 from latentrl.experiments.runner import RunTrials, Setup
 from latentrl.gplvm import GPLVM

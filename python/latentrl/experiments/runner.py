@@ -19,7 +19,7 @@ from typing import Any, NamedTuple, Protocol
 import numpy as np
 
 from latentrl.run_lock import run_lock
-from latentrl.task import end_reasons
+from latentrl.task import end_counts
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
     PER_EPISODE,
@@ -35,8 +35,6 @@ from latentrl.experiments.results import (
     write_npz,
 )
 
-END_CODES = dict(enumerate(end_reasons()))
-"""How an episode ended, as stored in `<learner>_end` (−1: not run): the native names."""
 
 #: A learner: runs trials `first .. first + n` and returns the native call's dict.
 RunTrials = Callable[..., dict[str, Any]]
@@ -220,11 +218,6 @@ def summarise_trial(arrays: Mapping[str, np.ndarray], name: str, trial: int) -> 
             test_ends=end_counts(test_ends),
         )
     return summary
-
-
-def end_counts(ends: np.ndarray) -> dict[str, int]:
-    """How many of `ends` (end codes) ended each way, by name, every ending listed."""
-    return {label: int((ends == code).sum()) for code, label in END_CODES.items()}
 
 
 def _empty(key: str, trials: int, episodes: int) -> np.ndarray:

@@ -45,7 +45,8 @@ from numpy.typing import NDArray
 
 from latentrl._files import MAX_SWEEP_FILE_BYTES, read_text
 from latentrl.experiments import RlExperiment, rl_experiments, task_schema
-from latentrl.experiments.presets import check_type, describe, with_overrides
+from latentrl.experiments.presets import check_type, describe
+from latentrl.run_settings import with_overrides
 from latentrl.experiments.ray_backend import RayBackend
 from latentrl.experiments.results import RunFolder, environment, read_json, worker_threads, write_json
 from latentrl.experiments.runner import Job, Setup, run_in_process, run_rl

@@ -33,7 +33,8 @@ import numpy as np
 from latentrl._base import atomic_write
 from latentrl._native import arms_fk
 from latentrl.datasets import arm_postures, bimanual_pairs, grip_error
-from latentrl.experiments.presets import check_floats, check_ints, check_run_fields, describe
+from latentrl.experiments.presets import describe
+from latentrl.run_settings import check_floats, check_ints, check_run_fields
 from latentrl.experiments.results import environment, worker_threads, write_json
 from latentrl.task import run_default
 

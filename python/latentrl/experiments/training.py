@@ -1,7 +1,8 @@
 """`latentrl train`: a latent policy on any task from a demo file (or a saved GPLVM), run with
 the one runner (docs/method.md §Results layout, resumable) and saved as `DIR/policy.npz`, with
 its figures: the return curve and, for a 2-D latent space, the value function before and after
-learning and where late episodes failed (the `[plot]` extra, imported when they are drawn)."""
+learning and where late episodes failed (the `[plot]` extra, imported when they are drawn).
+The same training from Python, in memory: `train_latent_policy` (`latentrl.train_latent_policy`)."""
 
 from __future__ import annotations
 
@@ -20,10 +21,10 @@ from latentrl._files import MAX_MESH_BYTES, MAX_TASK_FILE_BYTES, MAX_URDF_BYTES,
 from latentrl.demos import load_demos
 from latentrl.recorded import recording_kind
 from latentrl.recorded.options import DemoOptions
-from latentrl.experiments.presets import latent_box
 from latentrl.gplvm import GPLVM
-from latentrl.task import Task, end_reasons
-from latentrl.train import LatentPolicy, TrainPreset
+from latentrl.task import SHIPPED, Task, end_reasons
+from latentrl.run_settings import TrainPreset, latent_box, with_overrides, with_task_run
+from latentrl.train import RECORD, LatentPolicy
 
 if TYPE_CHECKING:  # the fit, the runner and the derivations load with the first run, not with `train --help`
     from latentrl.derive import Derived
@@ -185,6 +186,84 @@ def save_policy(run: TrainRun, out: Path) -> LatentPolicy:
                           weights=arrays["latent_weights"], preset=run, record=record)
     policy.save(out / "policy.npz")
     return policy
+
+
+# --- the same training from Python, in memory ---------------------------------------------
+
+
+def _preset_for(task: Task | str, quick: bool, fields: Mapping[str, Any]) -> tuple[Task, Any]:
+    """The task and the preset of a training run: a shipped task's name takes its experiment's
+    preset (Exp. 2, 3), a Task the `TrainPreset`; the task's `[run]` (where the preset holds its
+    class's default), then `fields` override either."""
+    if isinstance(task, str):
+        if task not in SHIPPED:
+            raise ValueError(f"task must be a Task or one of {list(SHIPPED)}, got {task!r}")
+        from latentrl.experiments import exp2, exp3
+
+        cls: Any = {"two_arms": exp2.Exp2Preset, "humanoid_lift": exp3.Exp3Preset}[task]
+        task = Task.shipped(task)
+    elif isinstance(task, Task):
+        cls = TrainPreset
+    else:
+        raise TypeError(f"task must be a latentrl.Task or a shipped task's name, got {type(task).__name__}")
+    preset = with_overrides(with_task_run(cls.quick() if quick else cls(), task), fields)
+    preset.validate()
+    return task.replace(preset.task), preset
+
+
+def train_latent_policy(
+    model: GPLVM,
+    task: Task | str = "two_arms",
+    *,
+    demos: Any = None,
+    preset: str = "quick",
+    progress: bool = False,
+    overrides: Mapping[str, Any] | None = None,
+    **fields: Any,
+) -> LatentPolicy:
+    """Trains the latent TD(0) learner of `task` through the physics sim in the latent space of
+    `model`, a GPLVM fitted to postures of the task's robot (columns in its joint order,
+    `task.joint_names`).
+
+    `preset` is ``"quick"`` (a short budget) or ``"paper"`` (the full one); the task's `[run]`
+    table replaces the paper preset's run settings, `fields` override the result by name
+    (``trials=4, episodes=500, seed=1``), `overrides` the task's keys by path
+    (``overrides={"learner.alpha": 0.5, "episode.max_steps": 200}``). `demos` (N, D): the postures a ``start = "demo"``
+    task starts from (default: the model's training postures). The latent box is the bounding
+    box of ``model.Z_`` widened by ``latent_margin``. Ctrl-C stops the run with
+    `KeyboardInterrupt`.
+    """
+    from latentrl.experiments.latent_runs import task_learner  # the runner and tqdm: at the first run
+    from latentrl.experiments.runner import Setup, episodes_per_trial, run_in_process
+    from latentrl.progress import progress_bar
+
+    if preset not in ("quick", "paper"):
+        raise ValueError(f"preset must be 'quick' or 'paper', got {preset!r}")
+    if not isinstance(model, GPLVM) or not hasattr(model, "decoder_"):
+        raise TypeError(f"model must be a fitted latentrl.GPLVM, got {model!r}")
+    task, chosen = _preset_for(task, preset == "quick", {**fields, **(overrides or {})})
+    if model.n_features_in_ != len(task.joint_names):
+        raise ValueError(
+            f"{task.name} needs a GPLVM fitted to postures of its {len(task.joint_names)} joints "
+            f"{list(task.joint_names)}; got n_features_in_={model.n_features_in_}"
+        )
+    starts = np.asarray(model.X_train_ if demos is None else demos, dtype=np.float64)
+    low, high = latent_box(model.Z_, chosen.latent_margin)
+    if isinstance(chosen, TrainPreset):  # a Task of yours (not a shipped experiment): derive what it leaves open
+        from latentrl.derive import applied, derive
+
+        task = applied(task, derive(task, model, low, high, starts, set(task.given)))
+    learner = task_learner(
+        task, model, (low, high), starts, episodes=chosen.episodes, seed=chosen.seed, test_episodes=chosen.test_episodes
+    )
+    built = Setup(learners={"latent": learner})
+    with progress_bar(total=chosen.trials * episodes_per_trial(chosen), unit="ep", desc="episodes", disable=not progress) as bar:
+        *_, result = next(iter(run_in_process(built, [("latent", 0, chosen.trials)], bar.update)))
+    return LatentPolicy(
+        task=task, model=model, demos=starts, latent_low=low, latent_high=high, weights=np.asarray(result["weights"]),
+        preset=chosen, record={k: np.asarray(result[k]) for k in RECORD},
+    )
+
 
 
 # --- the run and its figures ------------------------------------------------------------------
