@@ -24,12 +24,13 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._native import arms_elbows, arms_fk, arms_ik
+from latentrl._native import arms_elbows, arms_fk, arms_ik, bimanual_config
 from latentrl._native import grip_error as native_grip_error
 from latentrl._validation import as_matrix, int_at_least
 
-OFFSET = np.array([0.1, 0.0])
-"""The constraint: hand_R − hand_L (metres), docs/method.md §Experiment 1."""
+OFFSET = np.array(bimanual_config()[0]["grip"], dtype=np.float64)
+"""The constraint: hand_R − hand_L (metres), docs/method.md §Experiment 1: the bimanual plant's
+`grip` (`sim::bimanual::GRIP`, the offset of the native `grip_error` too)."""
 
 SHOULDERS = np.array([[-0.15, 0.0], [0.15, 0.0]])
 """Left and right shoulder (x, y) in metres (ours; docs/method.md §Experiment 2). Mirrors
