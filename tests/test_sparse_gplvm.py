@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from latentrl import GPLVM, _native
+from latentrl._base import minimise_nll
 
 
 def _problem(n: int = 40) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -154,3 +155,32 @@ def test_too_many_postures_name_the_ways_out() -> None:
     X = np.random.default_rng(0).standard_normal((_native.MAX_GP_POINTS + 1, 3))
     with pytest.raises(ValueError, match="inducing=M .*--max-postures"):
         GPLVM().fit(X)
+
+
+@pytest.mark.parametrize("postures", ["arms", "trajectories"])
+def test_second_stage_starts_from_the_lower_bound(postures: str) -> None:
+    """The second stage's start keeps the first stage's points and is the lower of two starts:
+    the first stage's GP encoder (on postures of a smooth 2-D manifold) or each posture's nearest
+    first-stage posture (on recorded trajectories, docs/demos.md)."""
+    from latentrl._base import initial_log_theta
+    from latentrl.gplvm import second_stage_start
+    from latentrl.inverse import fit_gp_encoder
+    from latentrl.pca import PCA
+    from recorded_writers import arm_episodes
+
+    X = _arms(600, 0) if postures == "arms" else np.concatenate(arm_episodes(600, per_episode=100))
+    pca = PCA(2).fit(X)
+    start, centred = pca.transform(X) / np.sqrt(pca.explained_variance_[0]), X - pca.mean_
+    rows, chosen = np.arange(0, 600, 3), np.arange(0, 600, 30)
+    options = {"noise_floor": 1e-6, "max_iter": 50, "tol": 1e-6}
+    first = minimise_nll(start[rows], centred[rows], initial_log_theta(start, centred), fit_latent=True,
+                         latent_prior=False, inducing=start[chosen], **options)
+    latent = second_stage_start(first, centred, rows, chosen, options)
+    np.testing.assert_array_equal(latent[rows], first.latent)
+    encoded = fit_gp_encoder(centred[rows], first.latent, inducing=centred[chosen], **options).predict_mean(centred)
+    encoded[rows] = first.latent
+
+    def bound(z: np.ndarray) -> float:
+        return float(_native.gplvm_nll_grad(z, centred, first.log_theta, inducing=first.inducing)[0])
+
+    assert bound(latent) <= bound(encoded)

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 
 from latentrl._base import Estimator, NllFit, SavedSpec, column_names, initial_log_theta, minimise_nll
 from latentrl import _native
-from latentrl._native import GpMap
+from latentrl._native import GpMap, gplvm_nll_grad
 from latentrl._validation import as_matrix, int_at_least, positive
 from latentrl.pca import PCA, check_n_components
 from latentrl.spacing import SPACINGS, evenly_spaced
@@ -88,7 +88,8 @@ class GPLVM(Estimator):
         one farthest from those chosen; fewer if fewer are distinct) and are optimised with Z and
         θ. Above `SPARSE_FIRST_STAGE` (4096) postures the fit has two stages: Z, the inducing
         inputs (chosen among them) and θ of 4096 evenly spaced postures, then all latent points
-        from where that stage's GP encoder puts them (`max_iter` caps each stage). Decoding is the DTC predictive mean and variance (O(m) and O(m²) per point); the GP
+        from where that stage's GP encoder puts them or at their nearest first-stage posture's
+        point, whichever start has the lower bound (`max_iter` caps each stage). Decoding is the DTC predictive mean and variance (O(m) and O(m²) per point); the GP
         encoder is a DTC GP through the postures of those m rows; the projection starts from the
         inducing input whose decoded posture is nearest. Not with encoder="back_constrained".
 
@@ -456,21 +457,40 @@ def minimise_sparse(start: NDArray[np.float64], centred: NDArray[np.float64], lo
     """The sparse GPLVM's fit from latent points `start` (N, d) of `centred` postures (N, D): the
     DTC bound minimised over the latent points of `rows`, the inducing inputs (starting at the
     latent points of the rows `chosen`, a subset of `rows`) and θ; then, if `rows` are not all,
-    over every latent point, each starting where the first stage's out-of-sample GP (a DTC GP
-    from those rows' postures to their latent points, through the `chosen` postures) encodes
-    its posture, and the first stage's inducing inputs and θ. `options` are `minimise_nll`'s;
-    `max_iter` caps each stage, and `n_iter` counts both."""
-    from latentrl.inverse import fit_gp_encoder
-
+    over every latent point from `second_stage_start`, and the first stage's inducing inputs and
+    θ. `options` are `minimise_nll`'s; `max_iter` caps each stage, and `n_iter` counts both."""
     first = minimise_nll(start[rows], centred[rows], log_theta, fit_latent=True, inducing=start[chosen], **options)
     if len(rows) == len(start):
         return first
-    encoder = fit_gp_encoder(centred[rows], first.latent, noise_floor=options["noise_floor"],
-                             max_iter=options["max_iter"], tol=options["tol"], inducing=centred[chosen])
-    latent = encoder.predict_mean(centred)
-    latent[rows] = first.latent
+    latent = second_stage_start(first, centred, rows, chosen, options)
     second = minimise_nll(latent, centred, first.log_theta, fit_latent=True, inducing=first.inducing, **options)
     return replace(second, n_iter=first.n_iter + second.n_iter)
+
+
+def second_stage_start(first: NllFit, centred: NDArray[np.float64], rows: NDArray[np.intp],
+                       chosen: NDArray[np.intp], options: dict[str, Any]) -> NDArray[np.float64]:
+    """Where the second stage starts every latent point, the first stage's `rows` at their fitted
+    points: the lower bound (under the first stage's U and θ) of two starts. Each posture where
+    the first stage's out-of-sample GP (a DTC GP from the rows' postures to their latent points,
+    through the `chosen` postures) encodes it, or at the latent point of its nearest first-stage
+    posture. The GP's start is near the optimum where the postures lie on a smooth d-dimensional
+    manifold; on recorded trajectories (docs/demos.md) it started 30× higher than the nearest
+    posture's, and the second stage then spent 230 of its 100 000-point iterations climbing down."""
+    from scipy.spatial import cKDTree
+
+    from latentrl.inverse import fit_gp_encoder
+
+    encoder = fit_gp_encoder(centred[rows], first.latent, noise_floor=options["noise_floor"],
+                             max_iter=options["max_iter"], tol=options["tol"], inducing=centred[chosen])
+    encoded = encoder.predict_mean(centred)
+    nearest = first.latent[cKDTree(centred[rows]).query(centred)[1]]
+    for latent in (encoded, nearest):
+        latent[rows] = first.latent
+
+    def bound(latent: NDArray[np.float64]) -> float:
+        return float(gplvm_nll_grad(latent, centred, first.log_theta, inducing=first.inducing)[0])
+
+    return min((encoded, nearest), key=bound)
 
 
 def latent_relevance(Z: NDArray[np.float64], theta: NDArray[np.float64]) -> NDArray[np.float64]:
