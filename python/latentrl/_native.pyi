@@ -235,7 +235,13 @@ def fall_check(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Runs the fall check (`sim::fallcheck::run_fall_check`) of `task` (a floating robot with a
     `[fall]` rule and a distance constraint, the grip): in the task's world, stand at `start`
-    `(D,)`, hold each row of `targets` `(M, D)` for `hold` s."""
+    `(D,)`, hold each row of `targets` `(M, D)` for `hold` s.
+    Returns `(table, frames)`. `table` `(M, 7)`: fell (0/1), smallest support margin (m),
+    final support margin (m), grip error at the end (hand distance − `grip_width`, m),
+    largest |grip error| (m), base height at the end (m), time of the fall (s since the
+    start, NaN while standing). `frames` `(K, 9 + D)`, one per `record_times` entry (s) that
+    the check reaches, taken at the first check (every 4 physics steps) at or after it: time
+    (s), fell (0/1), base position (m), base quaternion (x, y, z, w), joint positions."""
 
 def run_bimanual_trials(
     *,
@@ -256,7 +262,39 @@ def run_bimanual_trials(
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
     """Runs Experiment 1 (docs/method.md §Experiment 1) trials in parallel in Rust and returns their
-    records."""
+    records.
+
+    With `decoder`, `encoder`, `latent_low` and `latent_high` the latent learner runs (the
+    actions of `learner`, default the 2d axes; RBFs over [latent_low, latent_high]); without
+    them the full-space learner (12 actions, RBFs over the hands' box).
+    n_trials, episodes: T trials of E episodes each.
+    base_seed: trial i draws from ChaCha8(base_seed, stream i): same seed ⇒ same arrays,
+        whatever the thread count.
+    first_trial: run trials first_trial .. first_trial + n_trials (to resume); None means 0.
+    plant: a dict of BimanualConfig keys (`bimanual_schema()`); learner: a dict of LearnerConfig
+        keys; keys left out keep their defaults, unknown keys are errors.
+    decoder, encoder: a GpMap latent (d) → posture (4), and a GpMap or a Projection posture (4)
+        → latent (d).
+    latent_low, latent_high: (d,) corners of the latent box.
+    record_episodes: episode indices whose hand trajectories are recorded in every trial.
+    test_episodes: K frozen test episodes after training (no TD updates); None or 0 for none.
+    record_test_episodes: test-episode indices whose hand trajectories are recorded.
+    return_weights: also return each trial's final value-function weights.
+    progress: called as progress(episodes_done, episodes_total) about every 0.1 s and at
+        the end (test episodes count); an exception in it stops the run and propagates.
+
+    Returns a dict: "returns" (T, E) float64 (NaN where not run), "ends" (T, E) int8 (the
+    codes of END_REASONS; -1 not run), "steps" (T, E) int64, "reached" (T, E) bool, "passed"
+    (T, E) bool (always False here), the same five for the test episodes as "test_returns",
+    "test_ends", "test_steps", "test_reached", "test_passed" (T, K), "finished" (T,) bool,
+    "trials" (T,) int64, "trajectories" (T, R, max_steps + 1, 4) float64 hands (x_L, y_L,
+    x_R, y_R) after the reset and after each plant step, NaN-padded, "test_trajectories"
+    likewise, "test_starts" (T, K, 4) the row at the start of every test episode (NaN where
+    not run), "mean_states" (T, E, n) each training episode's mean learner state (n: 4 full,
+    d latent; NaN where not run), "weights" (T, M) float64 or None, "learner_low" /
+    "learner_high" / "spacing" (d,) of the RBF grid, "n_actions", "n_centres", and "plant" /
+    "learner" (the effective configurations). Ctrl-C stops all trials and raises
+    KeyboardInterrupt."""
 
 def bimanual_config(
     plant: Mapping[str, object] | None = None, learner: Mapping[str, object] | None = None
@@ -324,7 +362,7 @@ class Task:
         """Every collision shape as a dict (`urdf_info`'s shapes), to draw the robot."""
     @property
     def warnings(self) -> list[str]:
-        """What loading its URDF repaired, one sentence each."""
+        """What loading its URDF repaired (`balance_inertia` and the like), one sentence each."""
     @property
     def effectors(self) -> list[str]:
         """The names of the task's effectors."""
@@ -353,14 +391,16 @@ class TaskPlant:
         """The task's robot standing at its home posture."""
     def reset(self, posture: NDArray[np.float64]) -> int | None:
         """Puts the robot at `posture` (D,); None if it may start an episode, else the code of
-        the rule it breaks."""
+        the rule it breaks (END_REASONS: 1 obstacle, 2 outside the joint limits, 3 drop, 4 fall)."""
     def step(self, target: NDArray[np.float64]) -> tuple[float, int | None, NDArray[np.float64]]:
         """Tracks `target` (D,) for one RL step: `(reward, end code or None, reached posture (D,))`."""
     def classify(self, postures: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64], NDArray[np.float64]]:
         """For each posture (M, D) at rest: the code of the rule it breaks (0: none), the
-        effector positions (M, 3E) and the target's (M, 3E) in the world."""
+        effector positions (M, 3E) and the target's (M, 3E) in the world (they differ by posture
+        if `target.relative_to` is set)."""
     def sample_start(self, seed: int) -> NDArray[np.float64]:
-        """A start posture drawn by the task's start rule from ChaCha8 seeded with `seed`."""
+        """A start posture drawn by the task's start rule (its home plus ±`episode.start_noise`
+        uniform noise per joint) from ChaCha8 seeded with `seed`."""
     def effectors(self) -> NDArray[np.float64]:
         """The effector positions (3E,): x, y, z per effector."""
     def target_position(self) -> NDArray[np.float64]:
@@ -370,15 +410,20 @@ class TaskPlant:
     def targets(self) -> NDArray[np.float64]:
         """The servo targets after clamping (D,)."""
     def row(self) -> NDArray[np.float64]:
-        """The task-space row recorded in paths: effectors, base position and quaternion, joints."""
+        """The task-space row recorded in paths: effectors, base position and quaternion (x, y,
+        z, w), joints."""
     def link_poses(self) -> NDArray[np.float64]:
-        """World poses (L, 7) of every URDF link (position, quaternion x, y, z, w)."""
+        """World poses (L, 7) of every URDF link (position, quaternion x, y, z, w), in the order
+        of `Task.link_names`; NaN for a link without a body."""
     def constraint_errors(self) -> NDArray[np.float64]:
-        """Each constraint's error now, in task-file order."""
+        """Each constraint's error now (distance: signed m; offset: m; orientation: rad; plane: m
+        outside the bounds), in task-file order."""
     def support_margin(self) -> float:
-        """The static support margin now (m; needs a fall rule)."""
+        """The static support margin now (m, positive inside the soles' polygon; needs a fall rule)."""
     def pose_links(self, base: NDArray[np.float64], joints: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Link poses (L, 7) of the robot at `joints` with its base at `base` (7,)."""
+        """Link poses (L, 7) of the robot at `joints` (D,) with its base at `base` (7,: position,
+        quaternion x, y, z, w; ignored for a fixed root): the native kinematics of a recorded
+        path row, to draw it. Moves the robot there."""
     def center_of_mass(self) -> NDArray[np.float64]:
         """The robot's centre of mass now (3,), from the URDF inertials."""
     def reward(self) -> float:
@@ -400,11 +445,13 @@ class LatentPolicy:
         decoder: GpMap,
         encoder: GpMap | Projection,
     ) -> LatentPolicy:
-        """The policy of `learner` over [low, high] with `weights`."""
+        """The policy of `learner` (a dict of LearnerConfig keys) over [low, high] with `weights`,
+        decoding with `decoder` (latent → posture) and encoding with `encoder`."""
     def act(
         self, posture: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-        """The next servo target for the reached `posture`: `(target, z, next z)`."""
+        """The next servo target for the reached `posture` (D,): encode it, take the greedy latent
+        step (clamped into the box), decode. Returns `(target (D,), z (d,), next z (d,))`."""
     def values(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
         """V(z) at `points` (M, d): the learner's own values."""
 
@@ -429,7 +476,21 @@ def run_task_trials(
     return_weights: bool = False,
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
-    """One trial runner for every task: trials of the task's latent learner in parallel in Rust."""
+    """One trial runner for every task: trials of the task's latent learner (`task.learner`,
+    `task.episode`) in parallel in Rust, one plant per trial (a fresh world per episode for a
+    floating robot).
+
+    decoder: GpMap latent (d) → posture (D); encoder: GpMap or Projection posture → latent.
+    latent_low, latent_high: (d,) corners of the latent box. demos: (N, D) demonstrations (a
+    "demo" start uses row `episode.start_demo`). weights: (M,) value weights to start from (a
+    saved policy; default w₀ everywhere). rollout: run the `episodes` frozen, each action
+    "greedy", "softmax" or "random" (the control), each episode from its own generator (the
+    same starts for each); test_starts: a rollout starts where the frozen tests do.
+    n_trials, episodes, base_seed, first_trial, record_episodes, test_episodes,
+    record_test_episodes, return_weights, progress: as for run_bimanual_trials.
+
+    Returns the dict of run_bimanual_trials with paths of `task.row_len` columns (effectors,
+    base pose, joints) and "task" (the effective task as a dict)."""
 
 def latent_survey(
     task: Task,
@@ -442,8 +503,12 @@ def latent_survey(
     physics: bool = False,
     progress: Callable[[int, int], object] | None = None,
 ) -> dict[str, Any]:
-    """The task's latent space at rest on a grid at its learner step: per point the rule broken,
-    reward, distance, reached, effectors, and the fewest learner moves to the target region;
+    """The task's latent space at rest on a grid over [latent_low, latent_high] at its learner
+    step (coarsened to at most `max_points` points), each point decoded by `decoder` and
+    classified by the task's plant: {shape, stride, spacing, points (M, d), codes (M,), reward
+    (M,), distance (M,), reached (M,), effectors (M, 3E), moves (M,): fewest learner moves to
+    the target region, -1 for none; with `physics` each move also run from rest through the
+    physics: blocked (M·A,) and moves_in_physics (M,)};
     `region_points` (the region's points at the learner's step) and `closest` (the admissible
     point closest to the target: point, effectors, distance, reward; absent if none).
     `max_points` defaults to `sim::task::survey::DEFAULT_MAX_POINTS` (20 000)."""
@@ -455,11 +520,13 @@ def learner_values(
     weights: NDArray[np.float64] | None,
     points: NDArray[np.float64],
 ) -> NDArray[np.float64]:
-    """V(z) = wᵀ b(z) (Eq. 7) at `points` (M, d): the learner's own sparse features; weights
-    None: as built (w₀)."""
+    """V(z) = wᵀ b(z) (Eq. 7) at `points` (M, d) for `learner` (a dict of LearnerConfig keys)
+    over the latent box [low, high] with `weights`: the learner's own sparse features, as its
+    look-ahead sees them; weights None: as built (w₀)."""
 
 def task_schema() -> list[dict[str, Any]]:
-    """Every key of a task file as dicts `{key, doc, rule, kind, default}`."""
+    """Every key of a task file as dicts `{key, doc, rule, kind, default}`, table by table: the
+    source of docs/tasks.md and of the CLI's flags."""
 
 def run_config(run: Mapping[str, object] | None = None) -> dict[str, Any]:
     """The run settings `run` (a dict of `[run]` keys; defaults for the rest) checked: every

@@ -97,6 +97,36 @@ pub enum CoreError {
     },
 }
 
+/// What kind of failure an error is: what a caller (the Python binding) raises for it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// A wrong shape, a non-finite value, an impossible value: the caller's input.
+    Input,
+    /// A computation that could not be carried out stably.
+    Numerical,
+    /// The caller cancelled (Ctrl-C).
+    Cancelled,
+}
+
+impl CoreError {
+    /// The kind of this error.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            Self::Shape { .. }
+            | Self::NonFinite { .. }
+            | Self::Empty { .. }
+            | Self::InvalidParameter { .. }
+            | Self::NoValidStart { .. }
+            | Self::Param(_)
+            | Self::Plant { .. }
+            | Self::Argument(_)
+            | Self::TooLarge { .. } => ErrorKind::Input,
+            Self::NotPositiveDefinite { .. } | Self::Overflow { .. } => ErrorKind::Numerical,
+            Self::Cancelled => ErrorKind::Cancelled,
+        }
+    }
+}
+
 /// Result alias for the core.
 pub type Result<T> = std::result::Result<T, CoreError>;
 
@@ -134,5 +164,23 @@ pub fn check_positive(name: &'static str, value: f64) -> Result<()> {
             value,
             reason: "must be finite and > 0",
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kinds_sort_input_from_numerics_and_cancel() {
+        assert_eq!(
+            check_finite("x", &[1.0, f64::NAN]).unwrap_err().kind(),
+            ErrorKind::Input
+        );
+        assert_eq!(CoreError::Argument("n".into()).kind(), ErrorKind::Input);
+        let numerical = CoreError::NotPositiveDefinite { n: 2, jitter: 1e-6 };
+        assert_eq!(numerical.kind(), ErrorKind::Numerical);
+        assert_eq!(CoreError::Overflow { what: "v" }.kind(), ErrorKind::Numerical);
+        assert_eq!(CoreError::Cancelled.kind(), ErrorKind::Cancelled);
     }
 }

@@ -45,7 +45,7 @@ pub use rbf::{RbfConfig, RbfGrid, SparseFeatures};
 pub use results::{ResultArray, trial_arrays};
 pub use run::{Encoder, RunConfig};
 pub use space::StateSpace;
-pub use sparse_gplvm::{SparseNllGrad, sparse_nll_grad};
+pub use sparse_gplvm::{SparseNllGrad, gplvm_objective, sparse_nll_grad};
 pub use stopping::{Plateau, StopRule};
 pub use td::TdLearner;
 pub use trials::{LatentArgs, LatentSpace, RunArgs, TrialOptions, TrialResult, run_trials, trial_rng};

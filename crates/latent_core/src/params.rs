@@ -444,6 +444,16 @@ macro_rules! choice {
                     _ => None,
                 }
             }
+
+            /// The choice written `name` for the argument `what`, or an error listing the choices.
+            pub fn parse(what: &str, name: &str) -> $crate::error::Result<Self> {
+                Self::from_name(name).ok_or_else(|| {
+                    $crate::error::CoreError::Argument(format!(
+                        "{what} must be one of {}, got {name:?}",
+                        [$($text),*].join(" | ")
+                    ))
+                })
+            }
         }
 
         impl $crate::params::Check for $name {
@@ -584,5 +594,8 @@ mod tests {
         assert_eq!(Colour::DarkBlue.as_str(), "dark_blue");
         assert_eq!(Colour::from_name("dark_blue"), Some(Colour::DarkBlue));
         assert_eq!(Colour::from_name("DarkBlue"), None);
+        assert_eq!(Colour::parse("colour", "red").unwrap(), Colour::Red);
+        let wrong = Colour::parse("colour", "blue").unwrap_err().to_string();
+        assert_eq!(wrong, r#"colour must be one of red | dark_blue, got "blue""#);
     }
 }

@@ -121,11 +121,63 @@ pub trait Plant {
     fn admits_test_start(&self) -> bool {
         true
     }
+
+    /// A start posture drawn by [`Plant::sample_start`] from stream 0 of `seed`
+    /// ([`crate::trial_rng`]): the start of a caller stepping the plant itself.
+    fn seeded_start(&mut self, seed: u64) -> Vec<f64> {
+        let mut posture = vec![0.0; self.posture_dim()];
+        self.sample_start(&mut crate::trials::trial_rng(seed, 0), &mut posture);
+        posture
+    }
+
+    /// The current task-space row ([`Plant::task_position`]).
+    fn task_row(&self) -> Vec<f64> {
+        let mut row = vec![0.0; self.task_dim()];
+        self.task_position(&mut row);
+        row
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A point on a line, drawn uniformly from [0, 1); its row is `(x, 2x)`.
+    struct Line(f64);
+
+    impl Plant for Line {
+        fn posture_dim(&self) -> usize {
+            1
+        }
+        fn task_dim(&self) -> usize {
+            2
+        }
+        fn sample_start<R: Rng + ?Sized>(&mut self, rng: &mut R, posture: &mut [f64]) {
+            posture[0] = (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        }
+        fn reset(&mut self, posture: &[f64]) -> Option<EndReason> {
+            self.0 = posture[0];
+            None
+        }
+        fn step(&mut self, target: &[f64], reached: &mut [f64]) -> StepOutcome {
+            self.0 = target[0];
+            reached[0] = target[0];
+            StepOutcome { reward: 0.0, end: None }
+        }
+        fn task_position(&self, out: &mut [f64]) {
+            out.copy_from_slice(&[self.0, 2.0 * self.0]);
+        }
+    }
+
+    #[test]
+    fn a_seeded_start_follows_its_seed_and_the_row_its_plant() {
+        let mut line = Line(0.0);
+        let start = line.seeded_start(3);
+        assert_eq!((start.len(), start.clone()), (1, line.seeded_start(3)));
+        assert_ne!(start, line.seeded_start(4));
+        line.reset(&[0.25]);
+        assert_eq!(line.task_row(), [0.25, 0.5]);
+    }
 
     #[test]
     fn end_codes_and_names_round_trip() {

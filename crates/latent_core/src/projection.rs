@@ -201,6 +201,14 @@ impl Projection {
         Ok(latent)
     }
 
+    /// The latent point (d) of one caller's `posture` (D), checked ([`Self::check_posture`]).
+    pub fn encode_one(&self, posture: &[f64]) -> Result<Vec<f64>> {
+        self.check_posture(posture)?;
+        let mut z = vec![0.0; self.latent_dim()];
+        self.encode_into(posture, &mut z, &mut self.scratch());
+        Ok(z)
+    }
+
     /// Encodes one `posture` (length D) into `z` (length d): nearest-posture start, the two
     /// stages, the best of the three by density. Allocation-free; lengths and finiteness are
     /// the caller's contract ([`Self::check_posture`]).
@@ -344,6 +352,19 @@ mod tests {
             Projection::new(&decoder, postures.clone(), ProjectionConfig::default()).unwrap(),
             postures,
         )
+    }
+
+    #[test]
+    fn encode_one_checks_its_posture_and_agrees_with_the_batch() {
+        let (p, postures) = projection();
+        let one = p.encode_one(postures.column(3).as_slice()).unwrap();
+        let batch = p.encode(&postures.columns(3, 1).into_owned()).unwrap();
+        assert_eq!(one, batch.as_slice());
+        assert!(matches!(p.encode_one(&[0.0; 2]), Err(CoreError::Shape { .. })));
+        assert!(matches!(
+            p.encode_one(&[0.0, f64::NAN, 0.0]),
+            Err(CoreError::NonFinite { .. })
+        ));
     }
 
     /// Both objectives' gradients against central differences at points on and off the data,

@@ -11,8 +11,10 @@ use crate::trials::{TrialOptions, TrialResult};
 pub enum ResultArray {
     /// Floats of the shape.
     F64(Vec<f64>, Vec<usize>),
-    /// Small integers (end codes) of the shape.
+    /// Small integers (end codes, -1 for none) of the shape.
     I8(Vec<i8>, Vec<usize>),
+    /// Small unsigned integers (rule codes) of the shape.
+    U8(Vec<u8>, Vec<usize>),
     /// Integers of the shape.
     I64(Vec<i64>, Vec<usize>),
     /// Flags of the shape.

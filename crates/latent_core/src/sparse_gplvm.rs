@@ -21,7 +21,7 @@ use rayon::prelude::*;
 
 use crate::error::{CoreError, Result, check_finite};
 use crate::gp::{GpMap, check_gp_size, check_points, check_values};
-use crate::gplvm::NllGrad;
+use crate::gplvm::{NllGrad, nll_grad};
 use crate::kernel::{SeKernel, factorize};
 
 /// Points (columns of `K_mn`) per block of the passes over the data. Fixed: the partial sums,
@@ -236,6 +236,21 @@ struct BlockSums {
 ///
 /// With `G = ∂L/∂Σ = ½(D Σ⁻¹ − Σ⁻¹ Y Yᵀ Σ⁻¹)` and `W = K_mm⁻¹ K_mn`:
 /// `∂L/∂K_mn = 2 W G = P K_mn − α (Σ⁻¹ Y)ᵀ` with `P = (D/θ3) L⁻ᵀ B⁻¹ L⁻¹`,
+/// The GPLVM objective at `latent` (d×N) for `centred` data (D×N): the exact one
+/// ([`nll_grad`]), or with `inducing` (d×m) the sparse bound, its gradient that of the points
+/// then of the inducing inputs ([`SparseNllGrad::stacked`]).
+pub fn gplvm_objective(
+    latent: &DMatrix<f64>,
+    centred: &DMatrix<f64>,
+    log_theta: [f64; 3],
+    inducing: Option<&DMatrix<f64>>,
+) -> Result<NllGrad> {
+    match inducing {
+        None => nll_grad(latent, centred, log_theta),
+        Some(u) => sparse_nll_grad(latent, u, centred, log_theta).map(SparseNllGrad::stacked),
+    }
+}
+
 /// `∂L/∂K_mm = −W G Wᵀ = −(D/2) L⁻ᵀ (I − B⁻¹) L⁻¹ + ½ α αᵀ` and `∂L/∂θ3 = tr G`. The second pass
 /// over the points forms `∂L/∂K_mn` a block at a time (one m×m by m×c product) and carries it
 /// through the kernel at once: O(N m (m + q + D)) time, O(N m) memory (`K_mn`).
@@ -377,6 +392,19 @@ pub fn sparse_nll_grad(
 }
 
 impl GpMap {
+    /// The exact map ([`Self::new`]), or the sparse one through `inducing` ([`Self::sparse`]).
+    pub fn fit(
+        inputs: DMatrix<f64>,
+        outputs: DMatrix<f64>,
+        kernel: SeKernel,
+        inducing: Option<DMatrix<f64>>,
+    ) -> Result<Self> {
+        match inducing {
+            Some(u) => Self::sparse(u, &inputs, &outputs, kernel),
+            None => Self::new(inputs, outputs, kernel),
+        }
+    }
+
     /// The sparse GPLVM's decoder, the DTC predictive distribution of a GP trained on `inputs`
     /// (q×N) and `outputs` (p×N) through the inducing inputs `inducing` (q×m), which become the
     /// map's inputs: mean `k(x, U) α + mean` with `α = (θ3 K_mm + K_mn K_nm)⁻¹ K_mn (Y − mean)`,
@@ -413,11 +441,46 @@ impl GpMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gplvm::nll_grad;
     use crate::gplvm::tests::problem;
 
     fn inducing() -> DMatrix<f64> {
         DMatrix::from_row_slice(2, 4, &[-0.8, 0.1, 0.9, 0.3, -0.5, 0.6, -0.2, 0.4])
+    }
+
+    #[test]
+    fn fit_is_the_exact_map_without_inducing_inputs_and_the_sparse_one_with() {
+        let (latent, data, lt) = problem();
+        let kernel = SeKernel::new(lt.map(f64::exp)).unwrap();
+        let exact = GpMap::new(latent.clone(), data.clone(), kernel).unwrap();
+        let sparse = GpMap::sparse(inducing(), &latent, &data, kernel).unwrap();
+        let fitted = |u| {
+            GpMap::fit(latent.clone(), data.clone(), kernel, u)
+                .unwrap()
+                .predict_mean(&latent)
+                .unwrap()
+        };
+        assert_eq!(fitted(None), exact.predict_mean(&latent).unwrap());
+        assert_eq!(fitted(Some(inducing())), sparse.predict_mean(&latent).unwrap());
+    }
+
+    #[test]
+    fn the_objective_is_exact_without_inducing_inputs_and_stacked_with() {
+        let (latent, data, lt) = problem();
+        let (exact, objective) = (
+            nll_grad(&latent, &data, lt).unwrap(),
+            gplvm_objective(&latent, &data, lt, None),
+        );
+        assert_eq!(
+            (objective.as_ref().unwrap().nll, &objective.unwrap().grad_latent),
+            (exact.nll, &exact.grad_latent)
+        );
+        let sparse = sparse_nll_grad(&latent, &inducing(), &data, lt).unwrap();
+        let stacked = gplvm_objective(&latent, &data, lt, Some(&inducing())).unwrap();
+        assert_eq!(
+            (stacked.nll, stacked.grad_latent.shape()),
+            (sparse.nll, (2, latent.ncols() + 4))
+        );
+        assert_eq!(stacked.grad_latent.columns(latent.ncols(), 4), sparse.grad_inducing);
     }
 
     /// Central differences of `f` at every entry of `at` against `analytic`.

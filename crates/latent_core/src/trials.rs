@@ -24,7 +24,6 @@ use crate::episode::{EpisodeRecord, EpisodeScratch};
 use crate::error::{CoreError, Result};
 use crate::gp::GpMap;
 use crate::learner::{ActionRule, Learner, Phase};
-use crate::params::Kind;
 use crate::plant::Plant;
 use crate::space::StateSpace;
 
@@ -160,9 +159,7 @@ impl TrialOptions {
         let phase = match &args.rollout {
             None => Phase::Train,
             Some((name, test_starts)) => Phase::Rollout {
-                action: ActionRule::from_name(name).ok_or_else(|| {
-                    CoreError::Argument(format!("rollout must be one of {}, got {name:?}", ActionRule::kind()))
-                })?,
+                action: ActionRule::parse("rollout", name)?,
                 test_starts: *test_starts,
             },
         };
@@ -375,6 +372,16 @@ impl<'a> LatentArgs<'a> {
             .ok_or_else(|| CoreError::Argument(format!("decoder (a GpMap latent → posture) is required {context}")))
     }
 
+    /// The latent space as [`LatentArgs::check`] if any part is given; none if no part is
+    /// (Exp 1 then runs its full-space learner).
+    pub fn check_given(self, context: &str) -> Result<Option<LatentSpace<'a>>> {
+        if self.given() {
+            self.check(context).map(Some)
+        } else {
+            Ok(None)
+        }
+    }
+
     /// The decoder and the latent box, without an encoder (what a survey of the space needs).
     pub fn check_box(self, context: &str) -> Result<(&'a GpMap, Vec<f64>, Vec<f64>)> {
         let decoder = self.decoder(context)?;
@@ -558,6 +565,17 @@ impl<P: Plant> TrialRun<'_, P> {
 mod tests {
     use super::*;
     use rand::Rng;
+
+    #[test]
+    fn latent_args_are_checked_only_when_any_part_is_given() {
+        assert!(LatentArgs::default().check_given("here").unwrap().is_none());
+        let low_only = LatentArgs {
+            low: Some(Ok(vec![0.0])),
+            ..LatentArgs::default()
+        };
+        let err = low_only.check_given("here").unwrap_err().to_string();
+        assert_eq!(err, "decoder (a GpMap latent → posture) is required here");
+    }
 
     #[test]
     fn streams_differ_and_repeat() {

@@ -3,6 +3,7 @@
 
 use ::sim::SimError;
 use latent_core::CoreError;
+use latent_core::error::ErrorKind;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyValueError};
 use pyo3::prelude::*;
@@ -39,42 +40,21 @@ pub fn guard<T>(work: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
     latent_core::panic::catch(work, InternalError::new_err)
 }
 
-/// Converts a core error into its Python exception; the message says what and where.
+/// Converts a core error into the Python exception of its kind; the message says what and where.
 pub fn to_py(err: CoreError) -> PyErr {
-    let msg = err.to_string();
-    match err {
-        CoreError::Shape { .. }
-        | CoreError::NonFinite { .. }
-        | CoreError::Empty { .. }
-        | CoreError::InvalidParameter { .. }
-        | CoreError::NoValidStart { .. }
-        | CoreError::Param(_)
-        | CoreError::Plant { .. }
-        | CoreError::Argument(_)
-        | CoreError::TooLarge { .. } => InvalidInputError::new_err(msg),
-        CoreError::NotPositiveDefinite { .. } | CoreError::Overflow { .. } => NumericalError::new_err(msg),
-        CoreError::Cancelled => PyKeyboardInterrupt::new_err(msg),
-    }
+    raise(err.kind(), err.to_string())
 }
 
-/// Converts a plant error into its Python exception: the core's errors as [`to_py`], every
-/// other `sim` error is bad input.
+/// Converts a plant error into the Python exception of its kind.
 pub fn sim_to_py(err: SimError) -> PyErr {
-    let msg = err.to_string();
-    match err {
-        SimError::Input(core) => to_py(core),
-        SimError::Unreachable { .. }
-        | SimError::MissingFile { .. }
-        | SimError::MalformedUrdf { .. }
-        | SimError::UnsupportedJointType { .. }
-        | SimError::Mesh { .. }
-        | SimError::UnknownJoint { .. }
-        | SimError::UnknownLink { .. }
-        | SimError::InvalidJointParameter { .. }
-        | SimError::Param(_)
-        | SimError::Task { .. }
-        | SimError::UnknownObstacle { .. }
-        | SimError::DemoColumns { .. } => InvalidInputError::new_err(msg),
+    raise(err.kind(), err.to_string())
+}
+
+fn raise(kind: ErrorKind, msg: String) -> PyErr {
+    match kind {
+        ErrorKind::Input => InvalidInputError::new_err(msg),
+        ErrorKind::Numerical => NumericalError::new_err(msg),
+        ErrorKind::Cancelled => PyKeyboardInterrupt::new_err(msg),
     }
 }
 

@@ -1,7 +1,7 @@
 //! Binding of `latent_core::gp` and `latent_core::gplvm`.
 
 use latent_core::back_constraint::{encoder, nll_grad_back_constrained};
-use latent_core::{GpMap, SeKernel, SparseNllGrad, nll_grad, sparse_nll_grad};
+use latent_core::{GpMap, SeKernel, gplvm_objective};
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
@@ -33,8 +33,6 @@ pub struct PyGpMap {
 
 #[pymethods]
 impl PyGpMap {
-    /// Fits the map to `inputs` (N, q) and `outputs` (N, p) with `theta` = (θ1, θ2, θ3); with
-    /// `inducing` (m, q), the sparse (DTC) map through those inducing inputs.
     #[new]
     #[pyo3(signature = (inputs, outputs, theta, inducing = None))]
     fn new(
@@ -50,17 +48,12 @@ impl PyGpMap {
             let kernel = SeKernel::new(fixed::<3>("theta", &theta)?).map_err(to_py)?;
             let inducing = inducing.map(|u| points("inducing", &u)).transpose()?;
             let inner = py
-                .detach(|| match inducing {
-                    Some(u) => GpMap::sparse(u, &inputs, &outputs, kernel),
-                    None => GpMap::new(inputs, outputs, kernel),
-                })
+                .detach(|| GpMap::fit(inputs, outputs, kernel, inducing))
                 .map_err(to_py)?;
             Ok(Self { inner })
         })
     }
 
-    /// The back-constrained GPLVM's encoder: mean `weights · k_b(inputs, x)` with `weights`
-    /// (N, p) and the back-constraint kernel of squared length-scale `exp(log_beta)`.
     #[staticmethod]
     fn back_constraint(
         py: Python<'_>,
@@ -76,7 +69,6 @@ impl PyGpMap {
         })
     }
 
-    /// Means (M, p) and variances (M,) at `queries` (M, q).
     fn predict<'py>(&self, py: Python<'py>, queries: PyReadonlyArray2<'py, f64>) -> PyResult<MeansVariances<'py>> {
         guard(|| {
             let queries = points("queries", &queries)?;
@@ -85,7 +77,6 @@ impl PyGpMap {
         })
     }
 
-    /// Means only (M, p) at `queries` (M, q): no variance, several times faster.
     fn predict_mean<'py>(
         &self,
         py: Python<'py>,
@@ -98,7 +89,6 @@ impl PyGpMap {
         })
     }
 
-    /// Mean (p,) and variance at one point `x` (q,).
     fn predict_one<'py>(
         &self,
         py: Python<'py>,
@@ -111,34 +101,28 @@ impl PyGpMap {
         })
     }
 
-    /// Input dimension q.
     #[getter]
     fn input_dim(&self) -> PyResult<usize> {
         guard(|| Ok(self.inner.input_dim()))
     }
 
-    /// Output dimension p.
     #[getter]
     fn output_dim(&self) -> PyResult<usize> {
         guard(|| Ok(self.inner.output_dim()))
     }
 
-    /// Jitter added to the kernel matrix's diagonal to factorise it (0.0 if none).
     #[getter]
     fn jitter(&self) -> PyResult<f64> {
         guard(|| Ok(self.inner.jitter()))
     }
 
-    /// (θ1, θ2, θ3).
     #[getter]
     fn theta(&self) -> PyResult<[f64; 3]> {
         guard(|| Ok(self.inner.kernel().theta()))
     }
 }
 
-/// GPLVM objective at `latent` (N, d) for centred `data` (N, D): returns (nll, dnll/dlatent
-/// (N, d), dnll/dlog_theta (3,), jitter); with `inducing` (m, d) the sparse (DTC) bound, its
-/// gradient (N + m, d) that of the latent points then of the inducing inputs.
+/// GPLVM objective and gradient (the sparse DTC bound with `inducing`).
 #[pyfunction]
 #[pyo3(signature = (latent, data, log_theta, inducing = None))]
 pub fn gplvm_nll_grad<'py>(
@@ -154,10 +138,7 @@ pub fn gplvm_nll_grad<'py>(
         let log_theta = fixed::<3>("log_theta", &log_theta)?;
         let inducing = inducing.map(|u| points("inducing", &u)).transpose()?;
         let r = py
-            .detach(|| match inducing {
-                None => nll_grad(&latent, &data, log_theta),
-                Some(u) => sparse_nll_grad(&latent, &u, &data, log_theta).map(SparseNllGrad::stacked),
-            })
+            .detach(|| gplvm_objective(&latent, &data, log_theta, inducing.as_ref()))
             .map_err(to_py)?;
         Ok((
             r.nll,
@@ -168,9 +149,7 @@ pub fn gplvm_nll_grad<'py>(
     })
 }
 
-/// Back-constrained GPLVM objective at `weights` (N, d) for centred `data` (N, D), GPLVM kernel
-/// `exp(log_theta)` and back-constraint squared length-scale `exp(log_beta)`: returns (nll,
-/// dnll/dweights (N, d), dnll/dlog_theta (3,), dnll/dlog_beta, latent points (N, d), jitter).
+/// Back-constrained GPLVM objective and gradient.
 #[pyfunction]
 pub fn gplvm_back_constrained_nll_grad<'py>(
     py: Python<'py>,

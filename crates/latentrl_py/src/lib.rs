@@ -1,4 +1,5 @@
 //! `latentrl._native`: the module table. Each file converts one core module; nothing is decided here.
+//! What each class, method and function does is written once, in `python/latentrl/_native.pyi`.
 #![allow(missing_docs)]
 
 mod bimanual;

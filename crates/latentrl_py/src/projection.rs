@@ -21,9 +21,6 @@ pub struct PyProjection {
 
 #[pymethods]
 impl PyProjection {
-    /// The projection under `decoder` (a GpMap latent → posture) fitted to `postures` (N, D),
-    /// with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`;
-    /// `tracking`: after a move, search from the commanded latent point (docs/encoders.md).
     #[new]
     #[pyo3(signature = (decoder, postures, *, max_iter = DEFAULT.max_iter, margin = DEFAULT.margin, tracking = false))]
     fn new(
@@ -49,7 +46,6 @@ impl PyProjection {
         })
     }
 
-    /// Latent points (M, d) of `postures` (M, D), in parallel.
     fn encode<'py>(
         &self,
         py: Python<'py>,
@@ -62,28 +58,22 @@ impl PyProjection {
         })
     }
 
-    /// The latent point (d,) of one `posture` (D,): the call the Rust RL loop makes each step.
     fn encode_one<'py>(
         &self,
         py: Python<'py>,
         posture: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         guard(|| {
-            let x = posture.as_array().to_vec();
-            self.inner.check_posture(&x).map_err(to_py)?;
-            let mut z = vec![0.0; self.inner.latent_dim()];
-            self.inner.encode_into(&x, &mut z, &mut self.inner.scratch());
+            let z = self.inner.encode_one(&posture.as_array().to_vec()).map_err(to_py)?;
             Ok(PyArray1::from_vec(py, z))
         })
     }
 
-    /// Posture dimension D.
     #[getter]
     fn input_dim(&self) -> PyResult<usize> {
         guard(|| Ok(self.inner.posture_dim()))
     }
 
-    /// Latent dimension d.
     #[getter]
     fn output_dim(&self) -> PyResult<usize> {
         guard(|| Ok(self.inner.latent_dim()))

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use latent_core::trials::{Corner, LatentArgs};
-use latent_core::{GpMap, Learner, ResultArray, RunArgs, TrialOptions, TrialResult, trial_arrays};
+use latent_core::{GpMap, ResultArray, RunArgs, TrialOptions};
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -183,20 +183,14 @@ where
     })
 }
 
-/// The result dict of every trial runner (`latent_core::trial_arrays`, see
-/// `run_bimanual_trials`' docs) except its configurations.
-pub(crate) fn pack_results<'py>(
-    py: Python<'py>,
-    results: &[TrialResult],
-    template: &Learner,
-    options: &TrialOptions,
-    row: usize,
-) -> PyResult<Bound<'py, PyDict>> {
+/// Named arrays (`latent_core::trial_arrays`, a survey's) as a dict of NumPy arrays.
+pub(crate) fn named_arrays(py: Python<'_>, arrays: Vec<(String, ResultArray)>) -> PyResult<Bound<'_, PyDict>> {
     let out = PyDict::new(py);
-    for (name, array) in trial_arrays(results, template, options, row) {
+    for (name, array) in arrays {
         match array {
             ResultArray::F64(v, shape) => out.set_item(name, PyArray1::from_vec(py, v).reshape(shape)?),
             ResultArray::I8(v, shape) => out.set_item(name, PyArray1::from_vec(py, v).reshape(shape)?),
+            ResultArray::U8(v, shape) => out.set_item(name, PyArray1::from_vec(py, v).reshape(shape)?),
             ResultArray::I64(v, shape) => out.set_item(name, PyArray1::from_vec(py, v).reshape(shape)?),
             ResultArray::Bool(v, shape) => out.set_item(name, PyArray1::from_vec(py, v).reshape(shape)?),
             ResultArray::Count(n) => out.set_item(name, n),

@@ -16,11 +16,12 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
-use latent_core::error::Result;
+use latent_core::error::{Result, check_vector};
 use latent_core::params::{ParamError, Params, Rule};
 use latent_core::trials::{LatentSpace, TrialOptions, TrialResult, run_trials};
 use latent_core::{
-    CoreError, Encode, EndReason, EpisodeRules, GpMap, Learner, LearnerConfig, Plant, StateSpace, StepOutcome, params,
+    CoreError, Encode, EndReason, EpisodeRules, GpMap, Learner, LearnerConfig, Plant, ResultArray, StateSpace,
+    StepOutcome, params, trial_arrays,
 };
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
@@ -147,6 +148,18 @@ impl BimanualPlant {
     /// The current state `(x_L, y_L, x_R, y_R)`.
     pub fn state(&self) -> [f64; 4] {
         self.state
+    }
+
+    /// [`Plant::reset`] to a caller's `posture`, checked: 4 finite values.
+    pub fn reset_checked(&mut self, posture: &[f64]) -> Result<Option<EndReason>> {
+        check_vector("posture", posture, 4)?;
+        Ok(self.reset(posture))
+    }
+
+    /// [`Plant::step`] towards a caller's `target`, checked: 4 finite values.
+    pub fn step_checked(&mut self, target: &[f64]) -> Result<StepOutcome> {
+        check_vector("target", target, 4)?;
+        Ok(self.step(target, &mut [0.0; 4]))
     }
 }
 
@@ -318,6 +331,11 @@ impl<'a> BimanualTrials<'a> {
     pub fn run(&self, cancel: &AtomicBool, done: &AtomicUsize) -> Result<Vec<TrialResult>> {
         run_bimanual_trials(&self.plant, &self.config, &self.learner, &self.options, cancel, done)
     }
+
+    /// The arrays of `results` by name ([`trial_arrays`]), paths of the hands (4 values a row).
+    pub fn arrays(&self, results: &[TrialResult]) -> Vec<(String, ResultArray)> {
+        trial_arrays(results, &self.template, &self.options, 4)
+    }
 }
 
 /// Both of Experiment 1's configurations checked, a broken rule named `plant.*` or `learner.*`.
@@ -363,6 +381,21 @@ mod tests {
         assert_eq!(c.reward(&c.target), 1.0);
         assert!((c.reward(&[1.0, 1.0, 1.1, 1.0]) - (-3.0f64).exp()).abs() < 1e-15);
         assert!((c.rms_hand_distance(&[0.1, 0.0, 0.2, 0.0]) - 0.1).abs() < 1e-15);
+    }
+
+    #[test]
+    fn checked_reset_and_step_refuse_a_wrong_length_or_a_nan() {
+        let mut p = BimanualPlant::new(BimanualConfig::default()).unwrap();
+        let wrong = p.reset_checked(&[0.0; 3]).unwrap_err().to_string();
+        assert_eq!(wrong, "posture: expected shape (4,), got (3,)");
+        assert!(
+            p.step_checked(&[0.0, f64::NAN, 0.0, 0.0])
+                .unwrap_err()
+                .to_string()
+                .contains("non-finite")
+        );
+        assert_eq!(p.reset_checked(&[1.0, 1.0, 1.1, 1.0]).unwrap(), None);
+        assert_eq!(p.state(), [1.0, 1.0, 1.1, 1.0]);
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! The one error type of `sim`: every variant says what was wrong and where.
 
 use latent_core::CoreError;
+use latent_core::error::ErrorKind;
 
 /// Errors raised by the plants when their inputs are unusable.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -123,10 +124,34 @@ pub enum SimError {
     },
 }
 
+impl SimError {
+    /// The kind of this error: the core's own for its errors, bad input for every other.
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            Self::Input(core) => core.kind(),
+            _ => ErrorKind::Input,
+        }
+    }
+}
+
 /// Result alias for the plants.
 pub type Result<T> = std::result::Result<T, SimError>;
 
 /// Fails with [`CoreError::NonFinite`] at the first NaN or infinity in `values`.
 pub fn check_finite(what: &'static str, values: &[f64]) -> Result<()> {
     Ok(latent_core::error::check_finite(what, values)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_core_error_keeps_its_kind_and_every_other_is_input() {
+        let numerical = SimError::Input(CoreError::NotPositiveDefinite { n: 2, jitter: 1e-6 });
+        assert_eq!(numerical.kind(), ErrorKind::Numerical);
+        assert_eq!(SimError::Input(CoreError::Cancelled).kind(), ErrorKind::Cancelled);
+        let columns = SimError::DemoColumns { reason: "x".into() };
+        assert_eq!(columns.kind(), ErrorKind::Input);
+    }
 }

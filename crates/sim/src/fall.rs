@@ -254,6 +254,17 @@ pub fn reset_on_ground(
     sim.reset_with_base(posture, &lifted)
 }
 
+/// [`reset_on_ground`] on the world's own floor (an error if it has none), the sole where it
+/// stands at the identity base.
+pub fn reset_on_floor(sim: &mut World, posture: &[f64], sole: &str, clearance: f64) -> Result<()> {
+    let Some(ground) = sim.config.floor else {
+        return Err(
+            CoreError::Argument("reset_on_ground: this world has no floor (a floor height is needed)".into()).into(),
+        );
+    };
+    reset_on_ground(sim, posture, sole, ground, clearance, None)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

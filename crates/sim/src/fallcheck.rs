@@ -4,6 +4,7 @@
 //! the two hand frames minus the object's width).
 
 use latent_core::CoreError;
+use nalgebra::DMatrix;
 
 use crate::error::{Result, SimError, check_finite};
 use crate::fall::{FallCriteria, FallStatus, GROUND_CLEARANCE, reset_on_ground, support_margin};
@@ -129,17 +130,33 @@ impl SegmentReport {
     }
 }
 
+/// A task's fall check: a report per target and the frames recorded.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TaskFallCheck {
+    /// One report per target.
+    pub reports: Vec<SegmentReport>,
+    /// One frame per column: [`FRAME_HEAD`] values, then the joint positions.
+    pub frames: DMatrix<f64>,
+}
+
+impl TaskFallCheck {
+    /// The reports as a [`REPORT_COLUMNS`] × M matrix, one [`SegmentReport::row`] per column.
+    pub fn table(&self) -> DMatrix<f64> {
+        let rows = self.reports.iter().flat_map(SegmentReport::row);
+        DMatrix::from_iterator(REPORT_COLUMNS.len(), self.reports.len(), rows)
+    }
+}
+
 /// The fall check of `task` ([`FallCheckConfig::for_task`]) in its world: stand at `start`
 /// (D,), hold each column of `targets` (D × M) for `hold` s. Returns the reports and the
-/// frames recorded at `record_times` (s), each at the first check at or after it:
-/// [`FRAME_HEAD`] values, then the joint positions, frame after frame.
+/// frames recorded at `record_times` (s), each at the first check at or after it.
 pub fn run_task_fall_check(
     task: &Task,
     start: &[f64],
-    targets: &nalgebra::DMatrix<f64>,
+    targets: &DMatrix<f64>,
     hold: f64,
     record_times: &[f64],
-) -> Result<(Vec<SegmentReport>, Vec<f64>)> {
+) -> Result<TaskFallCheck> {
     if let Some(bad) = record_times.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
         return Err(CoreError::Argument(format!("record_times: expected finite times ≥ 0 s, got {bad}")).into());
     }
@@ -170,7 +187,9 @@ pub fn run_task_fall_check(
             frames.extend(sim.joint_positions());
         }
     })?;
-    Ok((reports, frames))
+    let width = FRAME_HEAD + start.len();
+    let frames = DMatrix::from_vec(width, frames.len() / width, frames);
+    Ok(TaskFallCheck { reports, frames })
 }
 
 /// [`run_fall_check`] that also calls `observe(sim, fell)` after the reset and after every
@@ -239,4 +258,37 @@ pub fn run_fall_check_observed(
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_table_holds_one_report_per_column_in_report_column_order() {
+        let report = |fell: bool, fall_time: Option<f64>| SegmentReport {
+            fell,
+            min_margin: 0.01,
+            final_margin: 0.02,
+            grip_error: 0.003,
+            max_grip_error: 0.004,
+            status: FallStatus {
+                fell,
+                base_height: 0.3,
+                sole_tilt: 0.0,
+                ground_contact: None,
+            },
+            fall_time,
+        };
+        let check = TaskFallCheck {
+            reports: vec![report(false, None), report(true, Some(1.5))],
+            frames: DMatrix::zeros(FRAME_HEAD, 0),
+        };
+        let table = check.table();
+        assert_eq!(table.shape(), (REPORT_COLUMNS.len(), 2));
+        let fall_time = REPORT_COLUMNS.iter().position(|c| *c == "fall_time").unwrap();
+        assert!(table[(fall_time, 0)].is_nan() && table[(fall_time, 1)] == 1.5);
+        assert_eq!((table[(0, 0)], table[(0, 1)]), (0.0, 1.0));
+        assert_eq!(table[(5, 1)], 0.3);
+    }
 }

@@ -45,6 +45,19 @@ pub struct Obstacle {
     pub sensor: bool,
 }
 
+impl Obstacle {
+    /// An axis-aligned box named `name` at `center` with `half_extents` (m).
+    pub fn aligned_box(name: &str, center: [f64; 3], half_extents: [f64; 3], sensor: bool) -> Self {
+        let [x, y, z] = center;
+        Self {
+            name: name.to_string(),
+            shape: ObstacleShape::Box { half_extents },
+            pose: Isometry3::translation(x, y, z),
+            sensor,
+        }
+    }
+}
+
 /// Index of an obstacle, in the order of [`crate::World::add_obstacle`] calls.
 pub type ObstacleId = usize;
 
@@ -88,5 +101,21 @@ impl ObstacleShape {
                 SharedShape::capsule(to_vector(a), to_vector(b), positive("radius", radius)?)
             }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_aligned_box_sits_unrotated_at_its_centre() {
+        let b = Obstacle::aligned_box("b", [1.0, 2.0, 3.0], [0.1, 0.2, 0.3], true);
+        assert_eq!(b.pose, Isometry3::translation(1.0, 2.0, 3.0));
+        let half_extents = [0.1, 0.2, 0.3];
+        assert_eq!(
+            (b.name.as_str(), b.shape, b.sensor),
+            ("b", ObstacleShape::Box { half_extents }, true)
+        );
     }
 }

@@ -414,9 +414,14 @@ impl UrdfModel {
     /// postures: for each actuated joint in URDF order, the index of its column. Columns may
     /// come in any order; a mimic joint's column is checked against its leader's
     /// ([`MimicInfo::follow`], within [`MIMIC_TOLERANCE`]) and dropped. Fails naming the
-    /// missing, unknown or repeated joint, or the first row where a mimic column disagrees.
+    /// missing, unknown or repeated joint, a row of another length, or the first row where a
+    /// mimic column disagrees.
     pub fn demo_columns(&self, names: &[&str], rows: &[Vec<f64>]) -> Result<Vec<usize>> {
         let bad = |reason: String| SimError::DemoColumns { reason };
+        if let Some(row) = rows.iter().find(|row| row.len() != names.len()) {
+            let n = names.len();
+            return Err(bad(format!("postures: {} columns for {n} joint names", row.len())));
+        }
         for (k, name) in names.iter().enumerate() {
             if names[..k].contains(name) {
                 return Err(bad(format!("joint {name:?} has two columns")));

@@ -79,3 +79,21 @@ fn fall_test_reads_base_height_tilt_and_ground_contacts() {
     assert_eq!(status.ground_contact.as_deref(), Some("arm"), "{status:?}");
     assert!(status.fell);
 }
+
+#[test]
+fn reset_on_floor_stands_the_sole_on_the_worlds_floor_and_needs_one() {
+    let mut sim = block();
+    sim::fall::reset_on_floor(&mut sim, &[0.0], "base", 0.0).unwrap();
+    let z = sim.base_pose().translation.z;
+    assert!(
+        (z - 0.05).abs() < 1e-9,
+        "the block's 0.1 m box rests on the floor: z = {z}"
+    );
+    let options = WorldConfig {
+        root: RootMode::Floating,
+        ..WorldConfig::default()
+    };
+    let mut bare = World::new(UrdfModel::parse(ROBOT).unwrap(), options).unwrap();
+    let err = sim::fall::reset_on_floor(&mut bare, &[0.0], "base", 0.0).unwrap_err();
+    assert!(err.to_string().contains("no floor"), "{err}");
+}

@@ -252,4 +252,5 @@ fn demo_columns_take_any_order_and_check_a_mimic_against_its_leader() {
     let r = reason(&["jc", "knee"], &[vec![0.0, 0.0]]);
     assert!(r.starts_with("missing ['ja'], not joints of the robot ['knee']"), "{r}");
     assert!(reason(&["ja", "jc", "ja"], &[vec![0.0; 3]]).contains("\"ja\" has two columns"));
+    assert_eq!(reason(&["jc", "ja"], &rows), "postures: 3 columns for 2 joint names");
 }

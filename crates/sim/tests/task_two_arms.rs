@@ -307,3 +307,27 @@ fn a_wall_crossed_within_one_rl_step_ends_only_when_every_physics_step_is_checke
     assert_eq!(end, Some(EndReason::Obstacle), "the wall was crossed in between");
     assert_eq!(h, h2, "the check does not change the motion");
 }
+
+#[test]
+fn a_checked_step_refuses_a_target_of_the_wrong_length() {
+    let mut p = TaskPlant::new(std::sync::Arc::new(common::task("two_arms")), None).unwrap();
+    let err = p.step_checked(&[0.0; 3]).unwrap_err().to_string();
+    assert_eq!(err, "target: expected shape (4,), got (3,)");
+    let q = holding(-0.2, 0.2);
+    assert_eq!(p.reset(&q), None);
+    let (outcome, reached) = p.step_checked(&q).unwrap();
+    assert!(outcome.end.is_none() && close(&reached, &q, 1e-2));
+}
+
+#[test]
+fn classify_gives_one_posture_per_column() {
+    let mut p = TaskPlant::new(std::sync::Arc::new(common::task("two_arms")), None).unwrap();
+    let (a, b) = (holding(-0.2, 0.2), holding(0.0, 0.3));
+    let c = p
+        .classify(&DMatrix::from_iterator(4, 2, a.iter().chain(&b).copied()))
+        .unwrap();
+    assert_eq!((c.codes.len(), c.effectors.shape()), (2, (p.effectors().len(), 2)));
+    assert_eq!(c.targets.shape(), c.effectors.shape());
+    p.reset(&b);
+    assert_eq!(c.effectors.column(1).as_slice(), p.effectors());
+}

@@ -298,18 +298,36 @@ impl TaskPlant {
             }
             .into());
         }
-        let mut out = Classified {
-            codes: Vec::with_capacity(postures.ncols()),
-            effectors: Vec::new(),
-            targets: Vec::new(),
-        };
+        let (m, e) = (postures.ncols(), self.effectors().len());
+        let (mut codes, mut effectors, mut targets) = (Vec::with_capacity(m), Vec::new(), Vec::new());
         for q in postures.column_iter() {
             let q: Vec<f64> = q.iter().copied().collect();
-            out.codes.push(self.reset(&q).map_or(0, |e| e.code() as i8));
-            out.effectors.extend_from_slice(self.effectors());
-            out.targets.extend(self.target_position());
+            codes.push(self.reset(&q).map_or(0, |e| e.code() as i8));
+            effectors.extend_from_slice(self.effectors());
+            targets.extend(self.target_position());
         }
-        Ok(out)
+        Ok(Classified {
+            codes,
+            effectors: nalgebra::DMatrix::from_vec(e, m, effectors),
+            targets: nalgebra::DMatrix::from_vec(e, m, targets),
+        })
+    }
+
+    /// [`Plant::step`] towards a caller's `target` (D,), its length checked: the outcome and
+    /// the reached posture.
+    pub fn step_checked(&mut self, target: &[f64]) -> Result<(StepOutcome, Vec<f64>)> {
+        let d = self.posture_dim();
+        if target.len() != d {
+            return Err(latent_core::CoreError::Shape {
+                what: "target",
+                expected: format!("({d},)"),
+                got: format!("({},)", target.len()),
+            }
+            .into());
+        }
+        let mut reached = vec![0.0; d];
+        let outcome = self.step(target, &mut reached);
+        Ok((outcome, reached))
     }
 
     /// `R(h) = exp(−θ ‖(h − h*)/ℓ‖²)` (paper Eq. 12 with a length unit ℓ) now.
@@ -568,8 +586,8 @@ impl Plant for TaskPlant {
 pub struct Classified {
     /// The code of the rule each posture breaks at rest (0: none).
     pub codes: Vec<i8>,
-    /// The effector positions, 3E values per posture.
-    pub effectors: Vec<f64>,
-    /// The target in the world, 3E values per posture.
-    pub targets: Vec<f64>,
+    /// The effector positions, one posture per column (3E × M).
+    pub effectors: nalgebra::DMatrix<f64>,
+    /// The target in the world, one posture per column (3E × M).
+    pub targets: nalgebra::DMatrix<f64>,
 }

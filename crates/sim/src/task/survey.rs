@@ -24,7 +24,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use latent_core::gp::GpMap;
-use latent_core::{Learner, Plant};
+use latent_core::{Learner, Plant, ResultArray};
 use rayon::prelude::*;
 
 use super::{Task, TaskPlant};
@@ -204,8 +204,67 @@ pub struct Survey {
     pub closest: Option<Closest>,
 }
 
+/// What a [`Survey`] found beyond its per-point arrays, by name: the grid's shape, stride and
+/// spacing, the target region's size and the closest point (left out if none).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SurveySummary {
+    /// Points per dimension.
+    pub shape: Vec<usize>,
+    /// Learner steps between neighbouring points.
+    pub stride: usize,
+    /// Distance between neighbouring points per dimension.
+    pub spacing: Vec<f64>,
+    /// [`Survey::region_points`].
+    pub region_points: usize,
+    /// [`Survey::closest`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub closest: Option<Closest>,
+}
+
+impl Survey {
+    /// The per-point arrays by name: `points` (M, d), `codes`, `reward`, `distance`, `reached`
+    /// (M,), `effectors` (M, 3E), `moves` and `moves_in_physics` (fewest moves, -1 for none),
+    /// `blocked` (M·A,).
+    pub fn arrays(&self) -> Vec<(String, ResultArray)> {
+        let (m, d) = (self.grid.len(), self.grid.shape().len());
+        let moves = |v: &[Option<usize>]| {
+            let v: Vec<i64> = v.iter().map(|x| x.map_or(-1, |n| n as i64)).collect();
+            let n = v.len();
+            ResultArray::I64(v, vec![n])
+        };
+        vec![
+            ("points".into(), ResultArray::F64(self.grid.points(), vec![m, d])),
+            ("codes".into(), ResultArray::U8(self.codes.clone(), vec![m])),
+            ("reward".into(), ResultArray::F64(self.reward.clone(), vec![m])),
+            ("distance".into(), ResultArray::F64(self.distance.clone(), vec![m])),
+            ("reached".into(), ResultArray::Bool(self.reached.clone(), vec![m])),
+            (
+                "effectors".into(),
+                ResultArray::F64(self.effectors.clone(), vec![m, self.effectors.len() / m.max(1)]),
+            ),
+            ("moves".into(), moves(&self.moves_to_target)),
+            ("moves_in_physics".into(), moves(&self.moves_in_physics)),
+            (
+                "blocked".into(),
+                ResultArray::Bool(self.blocked.clone(), vec![self.blocked.len()]),
+            ),
+        ]
+    }
+
+    /// The grid and the target region found, by name.
+    pub fn summary(&self) -> SurveySummary {
+        SurveySummary {
+            shape: self.grid.shape().to_vec(),
+            stride: self.grid.stride(),
+            spacing: self.grid.spacing().to_vec(),
+            region_points: self.region_points,
+            closest: self.closest.clone(),
+        }
+    }
+}
+
 /// An admissible latent point and what its decoded posture gives at rest.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Closest {
     /// The latent point.
     pub point: Vec<f64>,
@@ -569,6 +628,35 @@ mod tests {
         // Stride 3 along one axis: −1, 0, +1 steps.
         let line = LatentGrid::at_step(&[0.0], &[6.0], &[1.0], 3);
         assert_eq!((line.stride(), line.cell(1)), (3, vec![2.0, 3.0, 4.0]));
+    }
+
+    #[test]
+    fn a_survey_by_name_pads_no_path_with_minus_one() {
+        let grid = LatentGrid::at_step(&[0.0], &[1.0], &[0.5], 100);
+        let survey = Survey {
+            grid,
+            codes: vec![0, 1, 0],
+            reward: vec![-1.0, -2.0, 0.0],
+            distance: vec![0.2, 0.3, 0.01],
+            reached: vec![false, false, true],
+            effectors: vec![0.0; 9],
+            moves_to_target: vec![None, None, Some(0)],
+            blocked: Vec::new(),
+            moves_in_physics: Vec::new(),
+            region_points: 1,
+            closest: None,
+        };
+        let arrays = survey.arrays();
+        let get = |name: &str| arrays.iter().find(|(n, _)| n == name).map(|(_, a)| a.clone());
+        assert_eq!(get("points"), Some(ResultArray::F64(vec![0.0, 0.5, 1.0], vec![3, 1])));
+        assert_eq!(get("moves"), Some(ResultArray::I64(vec![-1, -1, 0], vec![3])));
+        assert_eq!(get("effectors"), Some(ResultArray::F64(vec![0.0; 9], vec![3, 3])));
+        assert_eq!(get("moves_in_physics"), Some(ResultArray::I64(Vec::new(), vec![0])));
+        let summary = survey.summary();
+        assert_eq!(
+            (summary.shape, summary.stride, summary.spacing),
+            (vec![3], 1, vec![0.5])
+        );
     }
 
     #[test]

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize};
 
 use latent_core::trials::LatentSpace;
-use latent_core::{CoreError, Learner, TrialOptions, TrialResult, run_trials};
+use latent_core::{CoreError, Learner, ResultArray, TrialOptions, TrialResult, run_trials, trial_arrays};
 
 use super::{Task, TaskPlant};
 use crate::error::Result;
@@ -48,6 +48,11 @@ impl<'a> TaskTrials<'a> {
         return Ok(Self { task, demos, latent, template, options });
     }
 
+    /// The task.
+    pub fn task(&self) -> &Task {
+        &self.task
+    }
+
     /// Runs the trials: see [`run_trials`] for seeding, cancellation, progress and test episodes.
     pub fn run(&self, cancel: &AtomicBool, done: &AtomicUsize) -> Result<Vec<TrialResult>> {
         let make = |_| {
@@ -61,5 +66,10 @@ impl<'a> TaskTrials<'a> {
             cancel,
             done,
         )?)
+    }
+
+    /// The arrays of `results` by name ([`trial_arrays`]), paths of the task's rows.
+    pub fn arrays(&self, results: &[TrialResult]) -> Vec<(String, ResultArray)> {
+        trial_arrays(results, &self.template, &self.options, self.task.row_len())
     }
 }
