@@ -446,12 +446,9 @@ macro_rules! choice {
             }
 
             /// The choice written `name` for the argument `what`, or an error listing the choices.
-            pub fn parse(what: &str, name: &str) -> $crate::error::Result<Self> {
+            pub fn parse(what: &str, name: &str) -> ::core::result::Result<Self, $crate::params::ParamError> {
                 Self::from_name(name).ok_or_else(|| {
-                    $crate::error::CoreError::Argument(format!(
-                        "{what} must be one of {}, got {name:?}",
-                        [$($text),*].join(" | ")
-                    ))
+                    $crate::params::ParamError::new(what, format!("must be one of {}, got {name:?}", [$($text),*].join(" | ")))
                 })
             }
         }

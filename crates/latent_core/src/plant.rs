@@ -122,14 +122,6 @@ pub trait Plant {
         true
     }
 
-    /// A start posture drawn by [`Plant::sample_start`] from stream 0 of `seed`
-    /// ([`crate::trial_rng`]): the start of a caller stepping the plant itself.
-    fn seeded_start(&mut self, seed: u64) -> Vec<f64> {
-        let mut posture = vec![0.0; self.posture_dim()];
-        self.sample_start(&mut crate::trials::trial_rng(seed, 0), &mut posture);
-        posture
-    }
-
     /// The current task-space row ([`Plant::task_position`]).
     fn task_row(&self) -> Vec<f64> {
         let mut row = vec![0.0; self.task_dim()];
@@ -170,11 +162,8 @@ mod tests {
     }
 
     #[test]
-    fn a_seeded_start_follows_its_seed_and_the_row_its_plant() {
+    fn the_row_is_the_plants() {
         let mut line = Line(0.0);
-        let start = line.seeded_start(3);
-        assert_eq!((start.len(), start.clone()), (1, line.seeded_start(3)));
-        assert_ne!(start, line.seeded_start(4));
         line.reset(&[0.25]);
         assert_eq!(line.task_row(), [0.25, 0.5]);
     }

@@ -298,6 +298,14 @@ where
         .collect()
 }
 
+/// A start posture of `plant` drawn by [`Plant::sample_start`] from stream 0 of `seed`
+/// ([`trial_rng`]): the start of a caller stepping the plant itself.
+pub fn seeded_start<P: Plant>(plant: &mut P, seed: u64) -> Vec<f64> {
+    let mut posture = vec![0.0; plant.posture_dim()];
+    plant.sample_start(&mut trial_rng(seed, 0), &mut posture);
+    posture
+}
+
 /// A latent space: the GPLVM maps and the latent box, checked by [`LatentArgs::check`].
 #[derive(Debug, Clone)]
 pub struct LatentSpace<'a> {
@@ -565,6 +573,14 @@ impl<P: Plant> TrialRun<'_, P> {
 mod tests {
     use super::*;
     use rand::Rng;
+
+    #[test]
+    fn a_seeded_start_follows_its_seed() {
+        let mut line = Line { x: 0.0 };
+        let start = seeded_start(&mut line, 3);
+        assert_eq!((start.len(), start.clone()), (1, seeded_start(&mut line, 3)));
+        assert_ne!(start, seeded_start(&mut line, 4));
+    }
 
     #[test]
     fn latent_args_are_checked_only_when_any_part_is_given() {

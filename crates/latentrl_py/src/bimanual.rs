@@ -109,7 +109,7 @@ impl PyBimanualPlant {
     }
 
     fn sample_start<'py>(&mut self, py: Python<'py>, seed: u64) -> Bound<'py, numpy::PyArray1<f64>> {
-        numpy::PyArray1::from_vec(py, latent_core::Plant::seeded_start(&mut self.inner, seed))
+        numpy::PyArray1::from_vec(py, latent_core::trials::seeded_start(&mut self.inner, seed))
     }
 
     fn state<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<f64>> {

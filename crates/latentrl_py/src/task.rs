@@ -7,6 +7,7 @@ use std::sync::Arc;
 use ::sim::task::survey::{DEFAULT_MAX_POINTS, LearnerGrid, survey};
 use ::sim::task::{SchemaTable, Task, TaskConfig, TaskPlant, TaskTrials};
 use ::sim::urdf::ShapeSummary;
+use latent_core::trials::seeded_start;
 use latent_core::{EndReason, LatentPolicy, Params, Plant, RunConfig};
 use nalgebra::DMatrix;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -203,7 +204,7 @@ impl PyTaskPlant {
     }
 
     fn sample_start<'py>(&mut self, py: Python<'py>, seed: u64) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_vec(py, self.inner.seeded_start(seed))
+        PyArray1::from_vec(py, seeded_start(&mut self.inner, seed))
     }
 
     fn effectors<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {

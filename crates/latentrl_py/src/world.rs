@@ -32,7 +32,7 @@ impl PySim {
         balance_inertia: bool,
     ) -> PyResult<Self> {
         guard(|| {
-            let root = RootMode::parse("root", root).map_err(to_py)?;
+            let root = RootMode::parse("root", root).map_err(|e| to_py(e.into()))?;
             #[rustfmt::skip]
             let config = WorldConfig { root, floor, physics: config_or_default("physics", physics)?,
                                        servo: config_or_default("servo", servo)? };
