@@ -10,20 +10,25 @@ use pyo3::prelude::*;
 use crate::convert::{points, to_points};
 use crate::errors::{InvalidInputError, guard, sim_to_py};
 
-/// The rows of `array` (named `name` in errors), which must be `(N, 4)`.
-fn rows_of_four(name: &str, array: &PyReadonlyArray2<'_, f64>) -> PyResult<DMatrix<f64>> {
+/// `f` of the rows of `array` (named `name` in errors), which must be `(N, 4)`, with the GIL
+/// released: (N, its result).
+fn rows_of_four<T: Send>(
+    py: Python<'_>,
+    name: &str,
+    array: &PyReadonlyArray2<'_, f64>,
+    f: impl FnOnce(&[f64]) -> ::sim::error::Result<T> + Send,
+) -> PyResult<(usize, T)> {
     let matrix = points(name, array)?;
     if matrix.nrows() != 4 {
+        let shape = (matrix.ncols(), matrix.nrows());
         return Err(InvalidInputError::new_err(format!(
-            "{name}: expected shape (N, 4), got ({}, {})",
-            matrix.ncols(),
-            matrix.nrows()
+            "{name}: expected shape (N, 4), got {shape:?}"
         )));
     }
-    Ok(matrix)
+    Ok((matrix.ncols(), py.detach(|| f(matrix.as_slice())).map_err(sim_to_py)?))
 }
 
-/// `f` of the PlanarArms over the rows of `array` `(N, 4)` (named `name` in errors), as `(N, 4)`.
+/// `f` of the PlanarArms over the rows of `array` `(N, 4)`, as `(N, 4)`.
 fn batch<'py>(
     py: Python<'py>,
     name: &str,
@@ -31,36 +36,30 @@ fn batch<'py>(
     f: fn(&PlanarArms, &[f64]) -> ::sim::error::Result<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     guard(|| {
-        let matrix = rows_of_four(name, array)?;
-        let out = py
-            .detach(|| f(&PlanarArms::default(), matrix.as_slice()))
-            .map_err(sim_to_py)?;
-        to_points(py, DMatrix::from_vec(4, matrix.ncols(), out))
+        let (n, out) = rows_of_four(py, name, array, |rows| f(&PlanarArms::default(), rows))?;
+        to_points(py, DMatrix::from_vec(4, n, out))
     })
 }
 
-/// Hands `(N, 4)` `[x_L, y_L, x_R, y_R]` of postures `(N, 4)` `[q1_L, q2_L, q1_R, q2_R]`
-/// (default geometry: shoulders (±0.15, 0), links 0.3 + 0.3 m).
+/// Hands `(N, 4)` of postures `(N, 4)` (default geometry).
 #[pyfunction]
 pub fn arms_fk<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     batch(py, "postures", &postures, PlanarArms::forward_batch)
 }
 
-/// Elbows `(N, 4)` `[x_L, y_L, x_R, y_R]` of postures `(N, 4)` (for drawing).
+/// Elbows `(N, 4)` of postures `(N, 4)` (for drawing).
 #[pyfunction]
 pub fn arms_elbows<'py>(py: Python<'py>, postures: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     batch(py, "postures", &postures, PlanarArms::elbows_batch)
 }
 
-/// Postures `(N, 4)` (elbows outward, shoulder angles continuous in front of the body) that
-/// put the hands at `hands` `(N, 4)`; an unreachable row raises InvalidInputError.
+/// Postures `(N, 4)` that put the hands at `hands` `(N, 4)`.
 #[pyfunction]
 pub fn arms_ik<'py>(py: Python<'py>, hands: PyReadonlyArray2<'py, f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     batch(py, "hands", &hands, PlanarArms::inverse_batch)
 }
 
-/// Grip error `(N,)` in metres of hands `(N, 4)` by `test`: `"distance"`
-/// `| ‖hand_R − hand_L‖ − 0.1 |` or `"vector"` `‖(hand_R − hand_L) − (0.1, 0)‖`.
+/// Grip error `(N,)` in metres of hands `(N, 4)` by `test` ("distance" or "vector").
 #[pyfunction]
 #[pyo3(signature = (hands, test = "distance"))]
 pub fn grip_error<'py>(
@@ -70,10 +69,7 @@ pub fn grip_error<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     guard(|| {
         let test: GripTest = test.parse().map_err(sim_to_py)?;
-        let matrix = rows_of_four("hands", &hands)?;
-        let out = py
-            .detach(|| grip_error_batch(matrix.as_slice(), test))
-            .map_err(sim_to_py)?;
+        let (_, out) = rows_of_four(py, "hands", &hands, |rows| grip_error_batch(rows, test))?;
         Ok(out.into_pyarray(py))
     })
 }

@@ -37,15 +37,11 @@ fn optional_int(name: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<Option
 
 /// A sequence of Python ints, or empty for None.
 fn ints(name: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<i128>> {
-    let Some(value) = value.filter(|v| !v.is_none()) else {
-        return Ok(Vec::new());
+    let extract = |v: &Bound<'_, PyAny>| {
+        v.extract()
+            .map_err(|_| invalid(format!("{name}: expected a sequence of ints, got {}", type_name(v))))
     };
-    let list: Vec<Bound<'_, PyAny>> = value
-        .try_iter()
-        .map_err(|_| invalid(format!("{name}: expected a sequence of ints, got {}", type_name(value))))?
-        .collect::<PyResult<_>>()?;
-    let name = format!("{name}[i]");
-    list.iter().map(|e| int(&name, e)).collect()
+    value.filter(|v| !v.is_none()).map_or(Ok(Vec::new()), extract)
 }
 
 /// A GpMap argument, or None.

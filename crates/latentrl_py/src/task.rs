@@ -124,13 +124,7 @@ impl PyTask {
     }
 
     fn __repr__(&self) -> String {
-        format!(
-            "Task({:?}, robot={:?}, joints={}, effectors={:?})",
-            self.inner.config().name,
-            self.inner.model().name(),
-            self.inner.model().joints().len(),
-            self.inner.config().effectors
-        )
+        self.inner.to_string()
     }
 }
 

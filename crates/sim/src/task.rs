@@ -36,6 +36,21 @@ pub struct Task {
     origin: String,
 }
 
+/// `Task("name", robot="robot", joints=N, effectors=[...])`: how a task shows itself.
+impl std::fmt::Display for Task {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (config, model) = (&self.config, &self.model);
+        write!(
+            f,
+            "Task({:?}, robot={:?}, joints={}, effectors={:?})",
+            config.name,
+            model.name(),
+            model.joints().len(),
+            config.effectors
+        )
+    }
+}
+
 impl Task {
     /// Reads a TOML task file: the URDF path is resolved against the file's folder. Errors
     /// name the file and the key path (`task.toml: learner.gamma must lie in [0, 1), got 1`).
