@@ -58,11 +58,6 @@ pub(crate) fn type_name(value: &Bound<'_, PyAny>) -> String {
 /// the conversion recurses per level, and 200 000 nested lists overflowed the stack).
 const MAX_CONFIG_DEPTH: usize = 32;
 
-/// Borrowed names (joints, links) as Python strings.
-pub fn owned(names: Vec<&str>) -> Vec<String> {
-    names.into_iter().map(str::to_string).collect()
-}
-
 /// A configuration (`TaskConfig`, `LearnerConfig`, …) from a Python dict: read as the TOML
 /// value it stands for, then deserialised as a task file is, so a bad value gets the task
 /// file's message (`learner.gamma: invalid type: string "x", expected f64`), naming `what` and

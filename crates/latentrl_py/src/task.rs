@@ -69,23 +69,18 @@ impl PyTask {
     }
 
     #[getter]
-    fn joint_names(&self) -> Vec<String> {
-        crate::convert::owned(self.inner.model().joint_names())
+    fn joint_names(&self) -> Vec<&str> {
+        self.inner.model().joint_names()
     }
 
     #[getter]
-    fn link_names(&self) -> Vec<String> {
-        crate::convert::owned(self.inner.model().link_names())
+    fn link_names(&self) -> Vec<&str> {
+        self.inner.model().link_names()
     }
 
     #[getter]
-    fn edges(&self) -> Vec<(String, String)> {
-        self.inner
-            .model()
-            .edges()
-            .into_iter()
-            .map(|(a, b)| (a.to_string(), b.to_string()))
-            .collect()
+    fn edges(&self) -> Vec<(&str, &str)> {
+        self.inner.model().edges()
     }
 
     fn collision_shapes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {

@@ -49,8 +49,8 @@ impl PySim {
     }
 
     #[getter]
-    fn joint_names(&self) -> Vec<String> {
-        crate::convert::owned(self.inner.model().joint_names())
+    fn joint_names(&self) -> Vec<&str> {
+        self.inner.model().joint_names()
     }
 
     #[getter]
