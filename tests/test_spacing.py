@@ -87,3 +87,13 @@ def test_the_run_setting_refuses_even_spacing_with_the_back_constraint():
         TrainPreset(encoder="back_constrained", latent_spacing="even").validate()
     with pytest.raises(ValueError, match="latent_spacing: unknown variant `ranks`"):
         TrainPreset(latent_spacing="ranks").validate()
+
+
+def test_the_check_names_an_evenly_spaced_fit_without_claiming_why():
+    from types import SimpleNamespace
+
+    from latentrl.check import fit_finding
+
+    even = fit_finding(SimpleNamespace(converged_=True, n_iter_=7, spacing="even"))
+    assert even.verdict == "ok" and even.message.endswith("evenly spaced along each axis (spacing='even')")
+    assert "evenly" not in fit_finding(SimpleNamespace(converged_=True, n_iter_=7, spacing="fit")).message

@@ -193,8 +193,9 @@ def demo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
 
 def fit_finding(model: Any) -> Finding:
     """Whether the GPLVM fit converged."""
-    spaced = ("; its latent points evenly spaced along each axis (the fit's own left no learner step that lands "
-              "in the target region within half an episode)" if getattr(model, "spacing", "fit") == "even" else "")
+    # The model says how its points were placed, not why: a model given to `check` may be spaced by its user.
+    spaced = "; its latent points evenly spaced along each axis (spacing='even')" \
+        if getattr(model, "spacing", "fit") == "even" else ""
     if getattr(model, "converged_", True):
         return Finding("fit", "ok", f"the GPLVM converged in {getattr(model, 'n_iter_', '?')} iterations{spaced}")
     return Finding("fit", "warning", f"the GPLVM stopped unconverged after {model.n_iter_} iterations",
