@@ -67,6 +67,32 @@ def test_a_target_outside_the_decodable_region_will_not_learn(glass):
     assert target.values["closest_m"] > 1.0 and "target.position = " in target.fix
 
 
+def survey(region_points: int, moves: int) -> dict:
+    """A latent survey of 100 admissible points, 95 of them `moves` learner moves from the target."""
+    steps = np.where(np.arange(100) < 95, moves, moves + 1)
+    return {"codes": np.zeros(100, dtype=np.int8), "moves": steps, "moves_in_physics": steps,
+            "blocked": np.zeros((100, 4)), "reward": np.full(100, 0.5), "shape": [10, 10], "stride": 1,
+            "region_points": region_points,
+            "closest": {"distance": 0.01, "point": [0.0, 0.0], "effectors": [0.0, 0.0, 0.0], "reward": 0.99}}
+
+
+@pytest.mark.parametrize(("max_steps", "verdict"), [(1000, "warning"), (200, "ok")])
+def test_a_region_one_step_wide_warns_only_where_a_half_step_still_fits(glass, max_steps, verdict):
+    """At half the step the starts need twice the moves; the step rule wants them within half an
+    episode (`derive.FIT`), and the zoo's Panda-style arm learnt a region 2 points wide where a half
+    step would not fit (100 % greedy): there the check keeps the step and says why."""
+    from latentrl.check import survey_findings
+
+    task, _, _ = glass
+    target = survey_findings(task.replace({"episode.max_steps": max_steps}), survey(2, 74))[1]
+    assert target.verdict == verdict
+    if verdict == "warning":
+        assert "can jump over it" in target.message and "learner.step = " in target.fix
+    else:
+        assert "more than 1/2 of episode.max_steps = 200" in target.message and target.fix is None
+    assert survey_findings(task, survey(3, 74))[1].verdict == "ok"
+
+
 def test_a_reach_radius_no_admissible_point_gets_will_not_learn(glass):
     task, demos, model = glass
     report = check(task.replace({"target.reach_radius": 1e-5}), demos, model)

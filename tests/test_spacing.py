@@ -71,6 +71,24 @@ def test_sparse_even_spacing_moves_inducing_inputs_by_the_same_map():
     np.testing.assert_allclose(even.inducing_, even_ranks(fit.Z_, fit.inducing_))
 
 
+@pytest.mark.parametrize("inducing", [None, 8])
+def test_spacing_a_fit_evenly_equals_fitting_it_evenly(inducing):
+    """`evenly_spaced` reuses this process's fit of the latent points: the same bits as a fresh
+    `spacing="even"` fit, and as one from a model whose fit it cannot reuse (loaded, re-parametrised)."""
+    X = clustered()
+    params = {"n_components": 1, "random_state": 0, "inducing": inducing}
+    fresh = GPLVM(**params, spacing="even").fit(X)
+    fit = GPLVM(**params).fit(X)
+    stale = GPLVM(**params, max_iter=5).fit(X).set_params(max_iter=fit.max_iter)  # its fit is not this one's
+    for model in (fit.evenly_spaced(), stale.evenly_spaced()):
+        assert model.spacing == "even" and model.n_iter_ == fresh.n_iter_
+        for name in ("Z_", "theta_", "inducing_", "encoder_theta_", "nll_"):
+            assert np.array_equal(getattr(model, name), getattr(fresh, name)), name
+    assert fit.spacing == "fit"  # the fit itself is kept
+    with pytest.raises(ValueError, match="spacing is already 'even'"):
+        fresh.evenly_spaced()
+
+
 @pytest.mark.parametrize(("params", "message"), [
     ({"spacing": "uniform"}, "spacing must be one of 'fit', 'even', got 'uniform'"),
     ({"spacing": "even", "encoder": "back_constrained"}, "back-constrained latent points are a function of X"),

@@ -97,16 +97,18 @@ def test_the_stock_panda_does_not_learn_the_bins_at_quick_and_its_rollout_says_s
     (obstacle) or tilt the gripper past 0.25 rad on the way over it (drop); `--encoder tracking`
     and `--encoder back_constrained` reached 0 % too. So the rollout agrees with the frozen
     tests in that neither the trained policy nor the control reaches the bin. Train 71 s wall.
-    `latentrl check` (GPLVM fitted to convergence) warns why: the target region is 2 admissible
-    points a learner step apart, about one step wide (docs/robots.md; it had said "will not learn"
-    when its coarsened grid fell between them)."""
+    `latentrl check` (GPLVM fitted to convergence) finds the target region 2 admissible points a
+    learner step apart, about one step wide, and keeps the step: at half of it the starts would
+    need more than half an episode (docs/robots.md; the zoo's Panda-style arm learnt in that state
+    at the default budget; the check had warned here before, and said "will not learn" when its
+    coarsened grid fell between the points)."""
     check = latentrl("check", STOCK / "panda_bins" / "task.toml", "--demos", STOCK / "panda_bins" / "demos.csv",
                      "--json", "--no-progress")
     assert check.returncode == 0, check.stderr
     findings = {f["name"]: f for f in json.loads(check.stdout)["findings"]}
     target = findings["target"]
-    assert target["verdict"] == "warning" and target["values"]["reached_points"] <= 2, target
-    assert "learner.step" in target["fix"]
+    assert target["verdict"] == "ok" and target["values"]["reached_points"] <= 2, target
+    assert "about one learner step wide, kept" in target["message"]
     learner = trained(tmp_path / "learner", "panda_bins")
     assert (learner["tests"] <= 0.2).all(), learner["tests"]
     rollout = learner["rollout"]

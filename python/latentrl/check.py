@@ -32,13 +32,14 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import cache, partial
+from functools import cache
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from latentrl import _native
+from latentrl.derive import FIT
 from latentrl.physics_check import HOLD_S, servo_error, servo_tolerance
 from latentrl.task import DEGREES, Task, end_reasons
 
@@ -128,13 +129,10 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     preset = with_task_run(TrainPreset(), task)
     even: Callable[[], Any] | None = None
     if model is None:  # fitted as `latentrl train` fits, its latent spacing derived as there
-
-        @cache
-        def fit(spacing: str) -> GPLVM:
-            return GPLVM(n_components=2, random_state=preset.seed, max_iter=preset.gplvm_max_iter,
-                         encoder=preset.encoder, spacing=spacing).fit(postures)
-
-        model, even = fit("fit"), partial(fit, "even")
+        auto = preset.latent_spacing == "auto"
+        model = GPLVM(n_components=2, random_state=preset.seed, max_iter=preset.gplvm_max_iter,
+                      encoder=preset.encoder, spacing="fit" if auto else preset.latent_spacing).fit(postures)
+        even = cache(model.evenly_spaced) if auto and preset.encoder != "back_constrained" else None
     low, high = latent_box(model.Z_, preset.latent_margin if latent_margin is None else latent_margin)
     if demo_finding(task, postures).verdict != "will not learn":  # else nothing to derive from: say why
         derived = derive(task, model, low, high, postures, set(task.given), even)
@@ -232,21 +230,27 @@ def survey_findings(task: Task, survey: dict[str, Any]) -> list[Finding]:
             f"target.position = {effectors} (reachable), or target.reach_radius = {np.ceil(best * 1000) / 1000:g}, "
             "or demos that reach the target", {"closest_m": best, "closest_z": where})
         return [box, target]
-    isolated = n_reached <= 2
+    # About one step wide, a step can jump over the region; a half step is the fix only where the
+    # starts would still reach it within 1/FIT of an episode (else `derive`'s step rule has chosen
+    # reaching it over landing in it: the zoo's Panda-style arm learnt so, 2 points wide).
+    physics = survey["moves_in_physics"]
+    reachable = physics[physics >= 0]
+    needed = int(np.percentile(reachable if len(reachable) else moves[moves >= 0], 95))
+    max_steps = config["episode"]["max_steps"]
+    isolated = n_reached <= 2 and FIT * 2 * needed <= max_steps
     target = Finding(
         "target", "warning" if isolated else "ok",
         f"{n_reached} admissible points a learner step apart are within {radius:g} m of the target (closest "
         f"{best * 1000:.1f} mm, best reward {max(float(survey['reward'][admissible].max()), closest['reward']):.3f})"
-        + ("; the region is about one learner step wide, so a step can jump over it" if isolated else ""),
+        + ("; the region is about one learner step wide, so a step can jump over it" if isolated else
+           f"; about one learner step wide, kept: at half the step 95 % of the starts would need about {2 * needed} "
+           f"moves, more than 1/{FIT} of episode.max_steps = {max_steps} (reaching the region comes first)"
+           if n_reached <= 2 else ""),
         f"learner.step = {config['learner']['step'] / 2:g} (half) lands more often inside it" if isolated else None,
         {"reached_points": n_reached, "closest_m": best})
-    physics = survey["moves_in_physics"]
     path_share = float((moves[admissible] >= 0).mean())
     moved_share = float((physics[admissible] >= 0).mean())
     blocked = float(np.asarray(survey["blocked"]).reshape(len(codes), -1)[admissible].mean())
-    reachable = physics[physics >= 0]
-    needed = int(np.percentile(reachable if len(reachable) else moves[moves >= 0], 95))
-    max_steps = config["episode"]["max_steps"]
     short = max_steps < needed
     verdict = "warning" if short or moved_share < PATH_SHARE else "ok"
     fix = []

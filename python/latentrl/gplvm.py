@@ -225,7 +225,12 @@ class GPLVM(Estimator):
             if self.n_components != "auto":
                 raise ValueError(f"n_components must be an int >= 1 or 'auto', got {self.n_components!r}")
             return self._fit_auto(X, names)
-        check_n_components(self.n_components, X)
+        return self._fit(X, names)
+
+    def _fit(self, X: NDArray[np.float64], names: Any, unspaced: Any = None) -> Self:
+        """`fit` with d = `n_components`; with `unspaced` (the best unspaced fit of a GPLVM with
+        the same parameters, but its spacing, to the same `X`), that fit instead of fitting again."""
+        d = check_n_components(self.n_components, X)
         inducing = self._check_inducing(len(X))
         if inducing is None and len(X) > _native.MAX_GP_POINTS:
             raise ValueError(f"X: {len(X)} postures, more than the {_native.MAX_GP_POINTS} an exact GPLVM fit takes "
@@ -240,7 +245,7 @@ class GPLVM(Estimator):
         tol = positive("tol", self.tol)
         self._check_encoder(self.encoder)
 
-        pca = PCA(self.n_components).fit(X)
+        pca = PCA(d).fit(X)
         start = pca.transform(X) / (np.sqrt(pca.explained_variance_[0]) or 1.0)
         centred = X - pca.mean_
         log_theta = initial_log_theta(start, centred)
@@ -270,14 +275,14 @@ class GPLVM(Estimator):
         chosen = np.zeros(0, dtype=np.intp) if inducing is None else rows[farthest_points(start[rows], inducing)]
         options: dict[str, Any] = {"latent_prior": bool(self.latent_prior), "noise_floor": noise_floor,
                                    "max_iter": max_iter, "tol": tol}
-        fits: list[Any] = [
+        fits: list[Any] = [unspaced] if unspaced is not None else [
             minimise_back_constrained(z0, centred, log_theta, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
             if back_constrained else
             minimise_nll(z0, centred, log_theta, fit_latent=True, **options) if inducing is None else
             minimise_sparse(z0, centred, log_theta, rows, chosen, **options)
             for z0 in starts
         ]
-        best = min(fits, key=lambda fit: fit.nll)
+        best = unspaced = min(fits, key=lambda fit: fit.nll)
         if self.spacing == "even":
             best = evenly_spaced(best, centred, noise_floor=noise_floor, max_iter=max_iter, tol=tol)
 
@@ -285,6 +290,8 @@ class GPLVM(Estimator):
         self._set_feature_names(names)
         self.mean_ = pca.mean_
         self.X_train_ = X.copy()
+        # The likelihood's own points, for `evenly_spaced` while these parameters and X hold (not saved).
+        self._unspaced = (self.get_params(), self.X_train_, unspaced)
         self.Z_ = best.latent
         self.theta_ = np.exp(best.log_theta)
         self.nll_ = best.nll
@@ -306,6 +313,21 @@ class GPLVM(Estimator):
         self.relevance_ = latent_relevance(self.Z_, self.theta_)
         self._build()
         return self
+
+    def evenly_spaced(self) -> GPLVM:
+        """This fit with `spacing="even"`: the same as `GPLVM(spacing="even", ...)` with these
+        parameters fitted to `X_train_`, to the bit, but from this fit's latent points where this
+        process made it (only θ and the encoder are fitted again; docs/encoders.md §Latent spacing)."""
+        self._check_fitted()
+        if self.spacing != "fit":
+            raise ValueError(f"evenly_spaced: this GPLVM's spacing is already {self.spacing!r}")
+        twin = GPLVM(**{**self.get_params(), "spacing": "even"})
+        names = getattr(self, "feature_names_in_", None)
+        if isinstance(twin.n_components, str):  # "auto" chooses d on evenly spaced fits
+            return twin._fit_auto(self.X_train_, names)
+        params, X, unspaced = getattr(self, "_unspaced", (None, None, None))
+        same = params == self.get_params() and X is self.X_train_
+        return twin._fit(self.X_train_, names, unspaced if same else None)
 
     def _fit_auto(self, X: NDArray[np.float64], names: Any) -> Self:
         """n_components="auto": the `max_components` fit's relevances choose d, then the fit

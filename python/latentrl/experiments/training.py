@@ -73,6 +73,12 @@ def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, mode
     return task, postures, gplvm
 
 
+@lru_cache(maxsize=1)
+def _evenly_spaced(model: GPLVM) -> GPLVM:
+    """`model.evenly_spaced()`, made once per fit (validation and setup share it)."""
+    return model.evenly_spaced()
+
+
 def fitted(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GPLVM]:
     """The task (with the run's overrides and the settings derived where they are silent), the
     demo postures and the GPLVM (fitted or loaded; with `out`, the one saved in that run
@@ -98,7 +104,7 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
 
     auto = run.latent_spacing == "auto"
     task, demos, model = load("fit" if auto else run.latent_spacing)
-    even = (lambda: load("even")[2]) if auto and not run.model and run.encoder != "back_constrained" else None
+    even = (lambda: _evenly_spaced(model)) if auto and not run.model and run.encoder != "back_constrained" else None
     if even is not None and any(d.key == SPACING for d in _derived(task, model, demos, run.latent_margin, even)):
         model = even()
     if out is not None:
