@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from latentrl.cli import saved_run
+from latentrl.saved_runs import saved_run
 from latentrl.experiments.results import RunFolder
 from latentrl.replay import episode_path, recorded, render_frames
 

@@ -67,7 +67,7 @@ def read_file(root: Path, name: str, *, draw: bool = False) -> None:
     """Every reader of the file `name` (one of FILES) of the folder under `root`, as the commands
     that read it call them; with `draw`, also what `replay` computes from what it read before
     drawing (the latent path, the links' poses: ~0.5 s an episode, in the GP encoder)."""
-    from latentrl.cli import saved_run
+    from latentrl.saved_runs import saved_run
     from latentrl.experiments.presets import describe
     from latentrl.experiments.results import RunFolder
     from latentrl.experiments.training import setup
@@ -97,7 +97,7 @@ def read_file(root: Path, name: str, *, draw: bool = False) -> None:
     if meta is not None:
         folder.check_continued(meta, built.learners, built.info, arrays)
     folder.finished()
-    # … and as `replay` does (cli._replay, replay.replay), short of rendering
+    # … and as `replay` does (cli_commands._replay, replay.replay), short of rendering
     experiment, preset = saved_run(out, train=True)
     with contextlib.ExitStack() as stack:
         stack.enter_context(_patched("render", lambda drawn, *_, **__: _check_drawn(drawn)))

@@ -199,8 +199,12 @@ ABOVE_EXPERIMENTS = {
     "latentrl": "re-exports `train_latent_policy` (documented as `latentrl.train_latent_policy`), which lives with "
                 "its experiment, loaded when first asked for (`__getattr__`)",
     "latentrl.__main__": "`python -m latentrl`: the command",
-    "latentrl.cli": "the `latentrl` command: dispatches to the experiments by name through the registry, and runs "
-                    "`train`, `rollout`, `report`, `plot`, `sweep` on their run folders",
+    "latentrl.cli": "the `latentrl` command's entry point: parses, then runs the subcommand (`cli_commands`)",
+    "latentrl.cli_parser": "the command's flags: `run NAME`'s are its experiment's preset fields and task keys, "
+                           "found through the registry when that subcommand is used",
+    "latentrl.cli_commands": "the subcommands: dispatch to the experiments by name through the registry, and run "
+                             "`train`, `rollout`, `report`, `plot`, `sweep` on their run folders",
+    "latentrl.saved_runs": "a run folder read back as its experiment's name and preset (the registry's presets)",
     "latentrl.replay": "`latentrl replay`: videos of a run folder's episodes, as the experiment that wrote it stored them",
 }
 """The modules above the experiments (the command and the package root's lazy re-export): the only

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from latentrl._native import run_task_trials
-from latentrl.cli import saved_run
+from latentrl.saved_runs import saved_run
 from latentrl.experiments import exp3
 from latentrl.experiments.exp3 import Exp3Preset
 from latentrl.experiments import run_experiment

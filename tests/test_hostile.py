@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from latentrl import GPLVM, cli
+from latentrl.saved_runs import saved_run
 from latentrl._native import InvalidInputError, Sim
 from latentrl.experiments import exp1
 from latentrl.experiments.latent_runs import Fitted
@@ -73,7 +74,7 @@ def test_class_4_a_run_uses_its_saved_model_where_a_refit_differs(finished_run, 
     saved = GPLVM.load(finished_run / "gplvm.npz")
     resumes_unchanged(finished_run)
     assert cli.main(["plot", str(finished_run), "--out", str(tmp_path / "figures")]) == 0
-    _, preset = cli.saved_run(finished_run)
+    _, preset = saved_run(finished_run)
     np.testing.assert_array_equal(exp1.fit(preset, finished_run).model.Z_, saved.Z_)
     assert not np.array_equal(exp1.fit(preset).model.Z_, saved.Z_), "the refit must differ for this test to mean anything"
 
@@ -83,7 +84,7 @@ def test_class_4_a_run_without_its_model_refuses_a_refit_that_differs(finished_r
     assert cli.main(["run", "exp1", "--resume", str(finished_run), "--no-progress"]) == 1
     err = capsys.readouterr().err
     assert "refitted on this machine" in err and "is not the one the saved trials used" in err, err
-    _, preset = cli.saved_run(finished_run)
+    _, preset = saved_run(finished_run)
     with pytest.raises(ValueError, match="is not the one the saved trials used"):
         exp1.fit(preset, finished_run)  # what replays and figures decode with
 

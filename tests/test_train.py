@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 from latentrl import GPLVM, PCA, LatentPolicy, Task, _reference
-from latentrl.cli import _training_run, build_parser
+from latentrl.cli import build_parser
+from latentrl.cli_commands import _training_run
 from latentrl.datasets import arm_postures
 from latentrl import train_latent_policy
 from latentrl.run_settings import latent_box

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 
 from latentrl import _native
-from latentrl.cli import saved_run
+from latentrl.saved_runs import saved_run
 from latentrl.experiments import exp3
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from latentrl.cli import saved_run
+from latentrl.saved_runs import saved_run
 from latentrl.experiments import exp3
 from latentrl.experiments.results import RunFolder
 from latentrl.task import end_reasons

@@ -345,7 +345,7 @@ def saved_preset(path: Path, value: np.ndarray) -> dict[str, Any]:
 def edited_fields(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any]) -> list[str]:
     """The preset fields that differ between `saved` and `now`. A task override that only
     restores what the trials ran with (`ran`: `task.ran_with` of the recorded task, empty if none
-    was recorded) is not an edit: `cli.saved_run` adds those when a shipped task changed since."""
+    was recorded) is not an edit: `saved_runs.saved_run` adds those when a shipped task changed since."""
     edited = [k for k in set(saved) | set(now) if k != "task" and saved.get(k) != now.get(k)]
     before, after = saved.get("task") or {}, now.get("task") or {}
     restored = {k for k in set(after) - set(before) if k in ran and ran[k] == after[k]}
