@@ -44,10 +44,10 @@ from scipy.optimize import fmin_l_bfgs_b
 from scipy.spatial.distance import pdist
 
 import latentrl
-import latentrl._base
+import latentrl._nll_fit
 import latentrl.gplvm
 from latentrl import GPLVM
-from latentrl._base import initial_log_theta
+from latentrl._nll_fit import initial_log_theta
 from latentrl._native import GpMap, gplvm_back_constrained_nll_grad, gplvm_nll_grad
 from latentrl.back_constraint import start_weights
 from latentrl._reference import gplvm_nll_grad as numpy_nll_grad
@@ -411,11 +411,11 @@ def back_constrained(
 
 def profile_fit(X: np.ndarray, target_nll: float | None) -> dict[str, Any]:
     """Where `GPLVM.fit`'s time goes: the native NLL + gradient of the GPLVM objective and of
-    the GP encoder's (both through `latentrl._base.gplvm_nll_grad`), the encoder fit as a whole,
+    the GP encoder's (both through `latentrl._nll_fit.gplvm_nll_grad`), the encoder fit as a whole,
     and the rest (SciPy's L-BFGS-B, the Python objective wrapper, PCA, the maps); and when the
     GPLVM objective first came to `target_nll` (GPy's final NLL) or below."""
     spent: dict[str, Any] = {"native_s": 0.0, "native_calls": 0, "encoder_fit_s": 0.0, "reached_target_s": None}
-    native, encoder_fit = latentrl._base.gplvm_nll_grad, latentrl.gplvm.fit_gp_encoder
+    native, encoder_fit = latentrl._nll_fit.gplvm_nll_grad, latentrl.gplvm.fit_gp_encoder
     started = time.perf_counter()
 
     def timed_native(*args: Any) -> Any:
@@ -434,12 +434,12 @@ def profile_fit(X: np.ndarray, target_nll: float | None) -> dict[str, Any]:
         spent["encoder_fit_s"] += time.perf_counter() - t
         return out
 
-    latentrl._base.gplvm_nll_grad, latentrl.gplvm.fit_gp_encoder = timed_native, timed_encoder_fit
+    latentrl._nll_fit.gplvm_nll_grad, latentrl.gplvm.fit_gp_encoder = timed_native, timed_encoder_fit
     try:
         GPLVM(2, max_iter=FIT_ITERS, noise_floor=NOISE_FLOOR).fit(X)
         total = time.perf_counter() - started
     finally:
-        latentrl._base.gplvm_nll_grad, latentrl.gplvm.fit_gp_encoder = native, encoder_fit
+        latentrl._nll_fit.gplvm_nll_grad, latentrl.gplvm.fit_gp_encoder = native, encoder_fit
     return {"median_s": total, **spent, "rest_s": total - spent["native_s"]}
 
 

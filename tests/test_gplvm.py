@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from latentrl import GPLVM, PCA, NotFittedError
-from latentrl._base import FORMAT_VERSION, initial_log_theta, minimise_nll
+from latentrl._nll_fit import initial_log_theta, minimise_nll
+from latentrl._persistence import FORMAT_VERSION
 from latentrl._native import gplvm_nll_grad
 
 

@@ -223,13 +223,13 @@ def test_class_3_model_files_that_would_unpack_huge_are_refused_before_unpacking
     """An NPZ whose header declares 10¹² elements, and a zip bomb (here: over a lowered limit)."""
     import zipfile
 
-    from latentrl import GPLVM, _base
+    from latentrl import GPLVM, _persistence
 
     with zipfile.ZipFile(tmp_path / "declared.npz", "w") as archive:
         archive.writestr("format.npy", _npy((10**12,), b"\0" * 64))
     with pytest.raises(ValueError, match="refused NPZ file: format.npy: its header declares 8000000000000 bytes"):
         GPLVM.load(tmp_path / "declared.npz")
-    monkeypatch.setattr(_base, "MAX_NPZ_BYTES", 2**20)
+    monkeypatch.setattr(_persistence, "MAX_NPZ_BYTES", 2**20)
     with zipfile.ZipFile(tmp_path / "bomb.npz", "w", compression=zipfile.ZIP_DEFLATED) as archive:
         archive.writestr("a.npy", _npy((2**18,), b"\0" * 2**21))
     assert (tmp_path / "bomb.npz").stat().st_size < 10_000

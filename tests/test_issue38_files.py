@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from latentrl import GPLVM, _native
-from latentrl._base import read_npz
+from latentrl._persistence import read_npz
 from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, open_regular, read_bounded, read_text
 from latentrl._native import InvalidInputError, Sim
 from latentrl.experiments.results import read_json
@@ -115,7 +115,7 @@ def test_a_file_over_its_cap_is_refused_naming_the_cap(tmp_path: Path, monkeypat
 
     model = tmp_path / "model.npz"
     GPLVM(n_components=1, max_iter=2, random_state=0).fit(np.random.default_rng(0).normal(size=(6, 2))).save(model)
-    monkeypatch.setattr("latentrl._base.MAX_NPZ_BYTES", 1024)
+    monkeypatch.setattr("latentrl._persistence.MAX_NPZ_BYTES", 1024)
     with pytest.raises(ValueError, match="model.npz: is \\d+ bytes, more than the 1024 bytes \\(1 KiB\\) an NPZ file"):
         GPLVM.load(model)
     results = tmp_path / "results.json"

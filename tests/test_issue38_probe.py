@@ -154,19 +154,19 @@ def test_a_full_disk_names_the_file_and_a_new_run_leaves_no_folder(tmp_path: Pat
     device" without the file and left a run folder holding gplvm.npz and no trial."""
     import errno
 
-    from latentrl import _base, cli
+    from latentrl import _persistence, cli
 
     def full(fh: object) -> None:
         raise OSError(errno.ENOSPC, "No space left on device")
 
     with pytest.raises(OSError, match=r"cannot write .*results\.json: No space left on device"):
-        _base.atomic_write(tmp_path / "results.json", full)
+        _persistence.atomic_write(tmp_path / "results.json", full)
     assert list(tmp_path.iterdir()) == []  # the temporary file is gone too
 
     from latentrl.experiments import results
 
     monkeypatch.setattr(results, "atomic_write",
-                        lambda path, write: _base.atomic_write(path, full if Path(path).name == "results.json" else write))
+                        lambda path, write: _persistence.atomic_write(path, full if Path(path).name == "results.json" else write))
     out = tmp_path / "run"
     code = cli.main(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--quick",
                      "--trials", "1", "--episodes", "2", "--test-episodes", "0", "--no-progress", "--out", str(out)])
@@ -178,8 +178,8 @@ def test_a_full_disk_names_the_file_and_a_new_run_leaves_no_folder(tmp_path: Pat
     # draw them again.
     from latentrl import plots
 
-    monkeypatch.setattr(results, "atomic_write", _base.atomic_write)
-    monkeypatch.setattr(plots, "atomic_write", lambda path, write: _base.atomic_write(path, full))
+    monkeypatch.setattr(results, "atomic_write", _persistence.atomic_write)
+    monkeypatch.setattr(plots, "atomic_write", lambda path, write: _persistence.atomic_write(path, full))
     code = cli.main(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--quick",
                      "--trials", "1", "--episodes", "2", "--test-episodes", "0", "--no-progress", "--out", str(out)])
     err = capsys.readouterr().err

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from latentrl import GPLVM, _native
-from latentrl._base import minimise_nll
+from latentrl._nll_fit import minimise_nll
 
 
 def _problem(n: int = 40) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -46,7 +46,7 @@ def test_gradient_holds_where_the_inducing_inputs_are_close() -> None:
     PCA start, K_mm's condition number ~1e12) the gradient's slope along itself is the bound's
     central difference. With A = L⁻¹ K_mn from an explicit L⁻¹ in the native kernel it was off by
     3e-4 (∂L/∂U 0.03 where it is 1e-5) and L-BFGS stopped after 4 iterations."""
-    from latentrl._base import initial_log_theta
+    from latentrl._nll_fit import initial_log_theta
     from latentrl.pca import PCA
     from latentrl.recorded.sampling import farthest_points
 
@@ -162,7 +162,7 @@ def test_second_stage_starts_from_the_lower_bound(postures: str) -> None:
     """The second stage's start keeps the first stage's points and is the lower of two starts:
     the first stage's GP encoder (on postures of a smooth 2-D manifold) or each posture's nearest
     first-stage posture (on recorded trajectories, docs/demos.md)."""
-    from latentrl._base import initial_log_theta
+    from latentrl._nll_fit import initial_log_theta
     from latentrl.gplvm import second_stage_start
     from latentrl.inverse import fit_gp_encoder
     from latentrl.pca import PCA

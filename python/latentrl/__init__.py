@@ -12,7 +12,7 @@ def _started_as_cli() -> bool:
 
 
 try:
-    from latentrl._base import NotFittedError
+    from latentrl._estimator import NotFittedError
     from latentrl._native import (
         GpMap,
         InternalError,

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.distance import pdist, squareform
 
-from latentrl._base import lbfgs
+from latentrl._nll_fit import lbfgs
 from latentrl._native import gplvm_back_constrained_nll_grad
 
 #: Ridge on K_b when the starting weights are solved from the starting latent points.

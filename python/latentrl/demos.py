@@ -23,7 +23,7 @@ from typing import IO, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import PathLike, atomic_write, read_npz
+from latentrl._persistence import PathLike, atomic_write, read_npz
 from latentrl.recorded import KINDS, open_recording, read_frames, recording_kind
 from latentrl.recorded.frames import renamed
 from latentrl.recorded.sampling import farthest_points

@@ -9,7 +9,8 @@ from typing import Any, ClassVar, Literal, Self, overload
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import Estimator, NllFit, SavedSpec, column_names, initial_log_theta, minimise_nll
+from latentrl._estimator import Estimator, SavedSpec, column_names
+from latentrl._nll_fit import NllFit, initial_log_theta, minimise_nll
 from latentrl import _native
 from latentrl._native import GpMap, gplvm_nll_grad
 from latentrl._validation import as_matrix, int_at_least, positive

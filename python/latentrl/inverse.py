@@ -9,7 +9,7 @@ from scipy.linalg import cho_factor, cho_solve
 from scipy.optimize import minimize
 from scipy.spatial.distance import cdist
 
-from latentrl._base import initial_log_theta, minimise_nll
+from latentrl._nll_fit import initial_log_theta, minimise_nll
 from latentrl._native import GpMap, NumericalError
 from latentrl._reference import se_kernel
 

@@ -7,7 +7,7 @@ from typing import Any, ClassVar, Self
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import Estimator, SavedSpec, column_names
+from latentrl._estimator import Estimator, SavedSpec, column_names
 from latentrl._validation import as_matrix, int_at_least
 
 

@@ -20,7 +20,7 @@ from matplotlib.patches import Circle  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
 from latentrl import _native  # noqa: E402
-from latentrl._base import atomic_write  # noqa: E402
+from latentrl._persistence import atomic_write  # noqa: E402
 
 
 def running_mean(values: NDArray[np.float64], window: int) -> NDArray[np.float64]:

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import atomic_path, read_npz
+from latentrl._persistence import atomic_path, read_npz
 from latentrl.render import VIEWS
 
 #: What `replay` writes, by suffix.

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import atomic_path
+from latentrl._persistence import atomic_path
 
 #: Pixels per side of the value map image.
 VALUE_PIXELS = 200

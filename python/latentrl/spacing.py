@@ -18,7 +18,7 @@ import dataclasses
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._base import NllFit, minimise_nll
+from latentrl._nll_fit import NllFit, minimise_nll
 
 SPACINGS = ("fit", "even")
 """`GPLVM.spacing`: the likelihood's own latent points, or the same points evenly spaced."""

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl import _native
-from latentrl._base import FORMAT_VERSION, PathLike, atomic_write, check_format, read_npz
+from latentrl._persistence import FORMAT_VERSION, PathLike, atomic_write, check_format, read_npz
 from latentrl.gplvm import GPLVM
 from latentrl.task import Task, end_counts, end_reasons
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from latentrl._base import atomic_write, read_npz
+from latentrl._persistence import atomic_write, read_npz
 from latentrl._files import MAX_JSON_BYTES, read_text
 from latentrl.task import changed_since, end_reasons, ran_with
 

@@ -30,7 +30,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from latentrl._base import atomic_write
+from latentrl._persistence import atomic_write
 from latentrl._native import arms_fk
 from latentrl.datasets import arm_postures, bimanual_pairs, grip_error
 from latentrl.experiments.presets import describe

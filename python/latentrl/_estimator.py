@@ -1,35 +1,19 @@
-"""Shared machinery of the estimators: parameters, input and column-name checks, the
-scikit-learn protocol, persistence, atomic writes and the L-BFGS fit of a GP's marginal
-likelihood (used by the GPLVM and the GP encoder)."""
+"""The estimators' shared contract (`Estimator`, scikit-learn's without depending on it):
+parameters, input and column-name checks, pickling, and NPZ save/load."""
 
 from __future__ import annotations
 
-import contextlib
 import inspect
 import json
-import os
-import struct
-import tokenize
-import uuid
 import warnings
-import zipfile
-import zlib
-from collections.abc import Callable, Collection, Iterator, Mapping, Sequence
-from dataclasses import dataclass
-from pathlib import Path
-from typing import IO, Any, ClassVar, Self
+from typing import Any, ClassVar, Self
 
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._files import open_regular
-from latentrl._native import LatentrlError, gplvm_nll_grad
+from latentrl._native import LatentrlError
+from latentrl._persistence import FORMAT_VERSION, PathLike, atomic_write, check_format, read_npz
 from latentrl._validation import as_matrix
-
-#: Version of the NPZ layout written by `Estimator.save`; `load` refuses any other.
-FORMAT_VERSION = 1
-
-PathLike = str | os.PathLike[str]
 
 #: Fitted attribute → (dtype kind, shape); see `Estimator`.
 SavedSpec = dict[str, tuple[str, tuple[str | int, ...]]]
@@ -37,111 +21,6 @@ SavedSpec = dict[str, tuple[str, tuple[str | int, ...]]]
 
 class NotFittedError(LatentrlError, AttributeError):
     """An estimator used before `fit`: a ValueError and an AttributeError, as in scikit-learn."""
-
-
-@contextlib.contextmanager
-def naming_os_errors(path: Path) -> Iterator[None]:
-    """An OSError raised inside (a full disk, a read-only folder) names `path`, unless it already
-    does: `cannot write PATH: No space left on device` (issue #38)."""
-    try:
-        yield
-    except OSError as err:
-        if str(path) in str(err):
-            raise
-        raise type(err)(err.errno, f"cannot write {path}: {err.strerror or err}") from err
-
-
-def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
-    """Calls `write` (its result is ignored) on a temporary file beside `path` (creating
-    missing parent directories), flushes it to disk, then renames it over `path`, so an
-    interrupted write never leaves a half-written file. A process killed mid-write leaves
-    only `.{name}.<hex>.tmp` behind. An OSError names `path` (`naming_os_errors`)."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    try:
-        with naming_os_errors(path):
-            path.parent.mkdir(parents=True, exist_ok=True)
-            with open(tmp, "xb") as fh:
-                write(fh)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
-@contextlib.contextmanager
-def atomic_path(path: PathLike) -> Iterator[Path]:
-    """A temporary file name beside `path` that keeps its suffix (for writers that take a name
-    and choose the format by it: imageio, rerun), renamed over `path` when the block ends and
-    removed if it raises, so such a writer never leaves a half-written `path`; an OSError in the
-    block names `path` (`naming_os_errors`)."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex}.tmp{path.suffix}")
-    try:
-        with naming_os_errors(path):
-            yield tmp
-            os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
-MAX_NPZ_BYTES = 2**30
-"""The most bytes an NPZ file read by latentrl (a model, a run's returns) may have, and the most
-bytes of arrays it may unpack to."""
-
-
-class _TooLarge(ValueError):
-    """An NPZ archive refused for its size, not for being corrupt."""
-
-
-def _check_npz_sizes(fh: IO[bytes]) -> None:
-    """Refuses, before anything is unpacked, an archive that would unpack to more than
-    MAX_NPZ_BYTES (a zip bomb) or a member whose header declares more data than the member
-    holds (an array of 10¹² elements in a small file)."""
-    with zipfile.ZipFile(fh) as archive:
-        members = archive.infolist()
-        total = sum(m.file_size for m in members)
-        if total > MAX_NPZ_BYTES:
-            raise _TooLarge(f"it unpacks to {total} bytes, more than the {MAX_NPZ_BYTES} latentrl reads")
-        for member in members:
-            with archive.open(member) as item:
-                version = np.lib.format.read_magic(item)
-                read_header = np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
-                shape, _, dtype = read_header(item)
-                declared = int(np.prod(shape, dtype=object)) * dtype.itemsize
-                if declared > member.file_size:
-                    raise _TooLarge(f"{member.filename}: its header declares {declared} bytes of data, the "
-                                    f"member holds {member.file_size}")
-
-
-def read_npz(path: PathLike, keys: Collection[str] | None = None) -> dict[str, NDArray[Any]]:
-    """Every array of the NPZ file at `path` (those named in `keys` if given), read eagerly
-    without pickles; a file that is not a regular file of at most MAX_NPZ_BYTES
-    (`latentrl._files`) or not a readable NPZ is a ValueError."""
-    with open_regular(path, MAX_NPZ_BYTES, "an NPZ file") as fh:
-        magic = fh.read(6)
-        if magic.startswith(b"\x93NUMPY"):
-            raise ValueError("not a readable NPZ file: it holds a single array (.npy), not an NPZ archive")
-        if not magic.startswith(b"PK\x03\x04"):
-            raise ValueError("not a readable NPZ file: it has no zip archive header (latentrl writes models and results as .npz)")
-        fh.seek(0)
-        try:
-            _check_npz_sizes(fh)
-            fh.seek(0)
-            npz = np.load(fh, allow_pickle=False)
-            if not isinstance(npz, np.lib.npyio.NpzFile):
-                raise ValueError("it holds a single array, not an NPZ archive")
-            with npz:
-                return {key: npz[key] for key in npz.files if keys is None or key in keys}
-        except _TooLarge as err:
-            raise ValueError(f"refused NPZ file: {err}") from None
-        # Issue #38: a flipped byte can also name an unknown compression method (NotImplementedError),
-        # spoil an array header (tokenize's TokenError, SyntaxError) or a zip record (struct.error).
-        except (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error, NotImplementedError, SyntaxError,
-                tokenize.TokenError, struct.error) as err:
-            raise ValueError(f"not a readable NPZ file (corrupt or truncated?): {err}") from err
 
 
 def column_names(X: Any) -> NDArray[np.object_] | None:
@@ -436,139 +315,3 @@ class Estimator:
             raise ValueError(f"{path}: inconsistent {expected} file: {err}") from err
         return estimator
 
-
-def check_format(arrays: Mapping[str, Any], expected: str, path: str) -> None:
-    """ValueError naming `path` unless `arrays` (a saved file's) hold the format `expected` (e.g.
-    "latentrl.GPLVM") at this latentrl's `FORMAT_VERSION`."""
-    found = str(arrays["format"]) if "format" in arrays else None
-    if found != expected:
-        raise ValueError(f"{path}: holds {found or 'no latentrl file'}, expected {expected}")
-    version = arrays.get("format_version")
-    if version is None or version.ndim != 0 or version.dtype.kind != "i" or int(version) != FORMAT_VERSION:
-        shown = "missing" if version is None else f"{version.tolist()!r} ({version.dtype})"
-        raise ValueError(f"{path}: format_version {shown} is not supported (this latentrl reads the integer "
-                         f"{FORMAT_VERSION})")
-
-
-#: The largest |log θ| a sparse fit evaluates: e^±700 is still a finite, non-zero float.
-MAX_LOG_THETA = 700.0
-
-#: The most inputs whose pairwise distances `initial_log_theta` takes the median of.
-MEDIAN_SAMPLE = 4096
-
-
-def initial_log_theta(
-    inputs: NDArray[np.float64], centred: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Starting log θ for a GP from `inputs` (N, q) to `centred` outputs (N, p): θ1 the mean
-    output variance, θ2 the median squared distance between inputs (between `MEDIAN_SAMPLE`
-    evenly spaced ones when N is larger: pdist of N points takes N²/2 floats), θ3 = θ1 / 100
-    (1 where a scale is zero)."""
-    from scipy.spatial.distance import pdist  # SciPy loads at a fit, not at `import latentrl`
-
-    variance = float(np.mean(centred**2)) or 1.0
-    sample = inputs[np.linspace(0, len(inputs) - 1, MEDIAN_SAMPLE).astype(np.intp)] if len(inputs) > MEDIAN_SAMPLE else inputs
-    lengthscale_sq = float(np.median(pdist(sample, "sqeuclidean"))) or 1.0
-    # Clamped at the smallest normal float: data of scale 1e-161 underflows θ3 to 0.
-    return np.log(np.maximum([variance, lengthscale_sq, variance / 100], np.finfo(np.float64).tiny))
-
-
-@dataclass(frozen=True)
-class NllFit:
-    """Result of `minimise_nll`."""
-
-    latent: NDArray[np.float64]
-    log_theta: NDArray[np.float64]
-    nll: float
-    n_iter: int
-    converged: bool
-    message: str
-    jitter: float
-    inducing: NDArray[np.float64] | None = None
-
-
-def lbfgs(objective: Callable[[NDArray[np.float64]], tuple[float, NDArray[np.float64]]], x0: NDArray[np.float64],
-          bounds: Sequence[tuple[float | None, float | None]], *, max_iter: int, tol: float) -> Any:
-    """scipy's L-BFGS-B on `objective` (value and gradient), stopping when the relative decrease
-    of the objective or the largest projected gradient falls below `tol`, or after `max_iter`
-    iterations: the one optimiser call of every likelihood fit here."""
-    from scipy.optimize import minimize
-
-    return minimize(objective, x0, jac=True, method="L-BFGS-B", bounds=bounds,
-                    options={"maxiter": max_iter, "ftol": tol, "gtol": tol})
-
-
-def minimise_nll(
-    latent: NDArray[np.float64],
-    data: NDArray[np.float64],
-    log_theta: NDArray[np.float64],
-    *,
-    fit_latent: bool,
-    latent_prior: bool,
-    noise_floor: float,
-    max_iter: int,
-    tol: float,
-    inducing: NDArray[np.float64] | None = None,
-) -> NllFit:
-    """Minimises the GP negative log marginal likelihood (paper Eq. 1, 3) of centred `data`
-    (N, D) given inputs `latent` (N, d) with L-BFGS-B and the analytic gradient: over
-    `log θ`, and over the inputs too if `fit_latent` (the GPLVM). θ3 is bounded below by
-    `noise_floor`; `latent_prior` adds ½‖Z‖². Stops when the relative decrease of the
-    objective or the largest projected gradient falls below `tol`, or after `max_iter`
-    iterations (then `converged` is False). With `inducing` (m, d) the objective is the sparse
-    (DTC) bound through those inducing inputs (docs/method.md §Sparse GPLVM), optimised with the
-    inputs if `fit_latent` (else held fixed)."""
-    n, d = latent.shape
-    # The points L-BFGS moves: the latent points, then the inducing inputs (the native
-    # gradient's row order); the data term alone with fixed inputs.
-    moved = np.vstack([latent, inducing]) if inducing is not None else latent
-
-    def split(params: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        return (params[:-3].reshape(moved.shape) if fit_latent else moved), params[-3:]
-
-    def evaluate(params: NDArray[np.float64]) -> tuple[float, NDArray[np.float64], NDArray[np.float64], float]:
-        points, lt = split(params)
-        if inducing is None:
-            return gplvm_nll_grad(points, data, lt)
-        return gplvm_nll_grad(points[:n], data, lt, inducing=points[n:])
-
-    def objective(params: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
-        if inducing is not None and np.max(np.abs(params[-3:])) > MAX_LOG_THETA:
-            # The sparse bound's gradient grows with N: on 100k frames L-BFGS-B's line search
-            # tried log θ2 = −1254 (θ2 underflows to 0). A huge value makes it step back.
-            return 1e300, np.zeros_like(params)
-        nll, grad_points, grad_lt, _ = evaluate(params)
-        grad = np.concatenate([grad_points.ravel(), grad_lt]) if fit_latent else grad_lt
-        if latent_prior:
-            z = split(params)[0][:n]
-            nll += 0.5 * float(np.sum(z * z))
-            if fit_latent:
-                grad[: n * d] += z.ravel()
-        return nll, grad
-
-    floor = np.log(noise_floor)
-    x0 = np.concatenate(
-        [moved.ravel() if fit_latent else [], log_theta[:2], [max(log_theta[2], floor)]]
-    )
-    bounds = [(None, None)] * (x0.size - 1) + [(floor, None)]
-    if inducing is None:
-        res = lbfgs(objective, x0, bounds, max_iter=max_iter, tol=tol)
-    else:
-        # L-BFGS-B's vector operations call BLAS, which OpenBLAS splits over spinning threads from
-        # ~10⁴ variables: on 200k variables (100k postures) and 2 busy cores that cost 30–50× the
-        # optimiser's own work (measured), and the split's rounding changes with the thread count.
-        from threadpoolctl import threadpool_limits
-
-        with threadpool_limits(limits=1, user_api="blas"):
-            res = lbfgs(objective, x0, bounds, max_iter=max_iter, tol=tol)
-    points, lt = split(res.x)
-    return NllFit(
-        np.array(points[:n]),
-        np.array(lt),
-        float(res.fun),
-        int(res.nit),
-        res.status == 0,
-        str(res.message),
-        evaluate(res.x)[3],
-        None if inducing is None else np.array(points[n:]),
-    )
