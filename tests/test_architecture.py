@@ -120,7 +120,7 @@ NOT_TASK_RULES = {
     ("check.py", "encoder_finding"): "a distance in latent space (encode ∘ decode round trip), in learner steps",
     ("datasets.py", "arm_hands"): "the demo generator's sampling region (shoulder→hand distance), which the plant "
                                   "never applies",
-    ("envs.py", "LatentSpaceWrapper.__init__"): "a PCA model's default latent box, ±3 s.d. of its components",
+    ("envs/latent_space.py", "LatentSpaceWrapper.__init__"): "a PCA model's default latent box, ±3 s.d. of its components",
     ("gplvm.py", "GPLVM._fit"): "the PCA initialisation scaled by its first s.d.",
     ("physics_check.py", "servo_error"): "the servos' tracking error against the rest poses",
     ("physics_check.py", "physics_error"): "the distance between two physics settings' tracks, against the "

@@ -12,6 +12,8 @@ from latentrl._native import arms_ik
 from latentrl.datasets import arm_postures, bimanual_pairs
 from latentrl.envs import BimanualReachEnv, LatentSpaceWrapper, TaskEnv, shipped_demos
 from latentrl.experiments.exp3 import demos_path
+from latentrl.run_settings import latent_box
+from latentrl.task import run_default
 
 IDS = sorted(env_id for env_id in gym.registry if env_id.startswith("latentrl/"))
 
@@ -227,6 +229,20 @@ def test_latent_wrapper_steps_through_the_decoder(arms_gplvm):
     assert not terminated and info["end_reason"] is None
     np.testing.assert_allclose(env.unwrapped.plant.targets(), target, atol=1e-12)
     np.testing.assert_allclose(z2, arms_gplvm.transform(env.unwrapped.posture[None])[0])
+
+
+def test_the_default_latent_box_is_the_runs_box(arms_gplvm):
+    """A GPLVM's default box is a latent RL run's (`run_settings.latent_box` at the `[run]` table's
+    margin): the bounding box of Z_ widened by 10 % of its width per side, to the bit."""
+    env = LatentSpaceWrapper(TwoArmsEnv(), arms_gplvm)
+    z = arms_gplvm.Z_
+    low, high = latent_box(z, run_default("latent_margin"))
+    width = z.max(axis=0) - z.min(axis=0)
+    assert run_default("latent_margin") == 0.1
+    np.testing.assert_array_equal(env.latent_low, low)
+    np.testing.assert_array_equal(env.latent_high, high)
+    np.testing.assert_array_equal(low, z.min(axis=0) - 0.1 * width)
+    np.testing.assert_array_equal(high, z.max(axis=0) + 0.1 * width)
 
 
 def test_latent_wrapper_refuses_box_exits_and_uncertain_targets(arms_gplvm):
