@@ -14,10 +14,10 @@ from pathlib import Path
 from typing import Any
 
 from latentrl.cli_parser import TASK_PREFIX
+from latentrl.rollout_summary import format_rollout
 from latentrl.run_lock import run_lock
 from latentrl.run_settings import with_overrides, with_task_run
 from latentrl.saved_runs import saved_run
-from latentrl.train import format_rollout
 
 
 def _overrides(args: argparse.Namespace, preset_cls: type) -> dict[str, Any]:

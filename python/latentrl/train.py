@@ -23,33 +23,16 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl._persistence import FORMAT_VERSION, PathLike, atomic_write, check_format, read_npz
+from latentrl.episode_ends import end_reasons
 from latentrl.gplvm import GPLVM
-from latentrl.task import Task, end_counts, end_reasons
+from latentrl.rollout_summary import format_rollout, rollout_summary
+from latentrl.task import Task
+
+__all__ = ["POLICIES", "RECORD", "LatentPolicy", "format_rollout", "rollout_summary"]
 
 
 POLICIES = ("greedy", "softmax", "random")
 """How a rollout acts: greedily, by the learner's soft-max, or uniformly at random (the control)."""
-
-
-def rollout_summary(ends: NDArray[Any], reached: NDArray[Any], returns: NDArray[Any], task: Task) -> dict[str, Any]:
-    """What rollout episodes of `task` did: "success" (the share that ended as the task's
-    success, `target.hold_steps`; None where the task has no such rule), "reached_any_step" (the
-    share within the reach radius after some step), the count of each ending, the mean return."""
-    rule = task.to_dict()["target"]["hold_steps"] > 0
-    return {
-        "success": float((ends == end_reasons().index("success")).mean()) if rule else None,
-        "reached_any_step": float(reached.mean()),
-        "ends": end_counts(ends),
-        "mean_return": float(returns.mean()),
-    }
-
-
-def format_rollout(summary: dict[str, Any]) -> str:
-    """One line of a rollout summary: success, reached at any step, mean return, endings."""
-    success = "-" if summary["success"] is None else f"{summary['success']:.0%}"
-    ends = ", ".join(f"{name} {n}" for name, n in summary["ends"].items() if n)
-    return (f"success {success:>4}  reached (any step) {summary['reached_any_step']:4.0%}  "
-            f"mean return {summary['mean_return']:8.2f}  ends: {ends}")
 
 
 RECORD = ("returns", "ends", "reached", "test_returns", "test_ends", "test_reached")
