@@ -21,7 +21,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from latentrl.experiments.results import environment, read_json, worker_threads, write_json
+from latentrl.experiments.results import environment, read_json, write_json
+from latentrl.machine import worker_threads
 
 
 def measure(experiment: str, extra: list[str]) -> dict[str, object]:

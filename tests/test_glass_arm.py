@@ -219,7 +219,7 @@ def test_a_stopped_trial_is_summarised_over_the_episodes_it_ran():
     """results.json's per-trial summary of a trial the stopping rule ended after 400 of 1000
     episodes: its last tenth is of the 400 (the zoo's iiwa-style arm had `mean_return_last` NaN
     and `reached_last` 0 from the budget's unset tail)."""
-    from latentrl.experiments.runner import summarise_trial
+    from latentrl.experiments.results import summarise_trial
 
     budget, ran = 1000, 400
     ends = np.full((1, budget), -1, dtype=np.int8)

@@ -135,7 +135,7 @@ def _report(args: argparse.Namespace) -> int:
 def _check(args: argparse.Namespace) -> int:
     from latentrl.check import check_task
     from latentrl.run_settings import latent_box
-    from latentrl.experiments.results import worker_threads
+    from latentrl.machine import worker_threads
     from latentrl.experiments.training import fitted
     from latentrl.progress import progress_bar
 

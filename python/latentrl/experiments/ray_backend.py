@@ -25,7 +25,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from latentrl.experiments.results import worker_threads
+from latentrl.machine import worker_threads
 from latentrl.experiments import rl_experiments
 from latentrl.experiments.presets import check_type
 from latentrl.experiments.results import PER_EPISODE, PER_TRIAL, RunFolder

@@ -1,5 +1,6 @@
 """Results files of a run (docs/method.md §Results layout): metadata JSON and per-episode NPZ,
-written atomically; what returns.npz and gplvm.npz hold; and `RunFolder`, a run's directory read
+written atomically; what returns.npz and gplvm.npz hold (rows of trials not run yet, each trial's
+summary in results.json); and `RunFolder`, a run's directory read
 back: its preset, recorded task, inputs and fit, its arrays and its model, with the checks that
 a run resumed, replayed, plotted or rolled out is the run it says it is (issue #38)."""
 
@@ -7,10 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
-import platform
-import resource
-import subprocess
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -19,7 +16,8 @@ import numpy as np
 
 from latentrl._persistence import atomic_write, read_npz
 from latentrl._files import MAX_JSON_BYTES, read_text
-from latentrl.task import changed_since, end_reasons, ran_with
+from latentrl.machine import machine
+from latentrl.task import changed_since, end_counts, end_reasons, ran_with
 
 if TYPE_CHECKING:  # the GPLVM (and SciPy) load with the first run read back, not with `--help`
     from latentrl.gplvm import GPLVM
@@ -388,6 +386,60 @@ def finished_trials(arrays: Mapping[str, np.ndarray]) -> tuple[dict[str, np.ndar
     return kept, {name: int(mask.sum()) for name, mask in done.items() if mask.any()}
 
 
+def summarise_trial(arrays: Mapping[str, np.ndarray], name: str, trial: int) -> dict[str, Any]:
+    """Per-trial figures for results.json: early/late mean return, end counts, reach and pass
+    rates over the episodes the trial ran (a trial the stopping rule ended ran fewer than its
+    budget; the rest are unset, end −1); with frozen test episodes also `test_success` (share
+    that reached the target), `test_passed`, their mean return and end counts."""
+    ends = arrays[array_key(name, "ends")][trial]
+    ran = int((ends >= 0).sum()) or len(ends)
+    ends = ends[:ran]
+    returns = arrays[array_key(name, "returns")][trial][:ran]
+    reached = arrays[array_key(name, "reached")][trial][:ran]
+    passed = arrays[array_key(name, "passed")][trial][:ran]
+    window = max(1, len(returns) // 10)
+    summary: dict[str, Any] = {
+        "mean_return_first": float(returns[:window].mean()),
+        "mean_return_last": float(returns[-window:].mean()),
+        "reached_last": float(reached[-window:].mean()),
+        "passed_last": float(passed[-window:].mean()),
+        "window": window,
+        "ends": end_counts(ends),
+    }
+    if array_key(name, "test_ends") in arrays:
+        test_ends = arrays[array_key(name, "test_ends")][trial]
+        summary.update(
+            test_success=float(arrays[array_key(name, "test_reached")][trial].mean()),
+            test_passed=float(arrays[array_key(name, "test_passed")][trial].mean()),
+            test_mean_return=float(arrays[array_key(name, "test_returns")][trial].mean()),
+            test_ends=end_counts(test_ends),
+        )
+    return summary
+
+
+def not_run(key: str, trials: int, episodes: int) -> np.ndarray:
+    """A (trials, episodes) array of the per-episode `key` before any trial ran: NaN returns, end −1,
+    nothing reached, zero counts."""
+    if key == "returns":
+        return np.full((trials, episodes), np.nan)
+    if key == "ends":
+        return np.full((trials, episodes), -1, dtype=np.int8)
+    if key == "reached":
+        return np.zeros((trials, episodes), dtype=bool)
+    return np.zeros((trials, episodes), dtype=np.int64)
+
+
+def not_run_like(value: np.ndarray, trials: int) -> np.ndarray:
+    """A (trials, …) array for per-trial rows like `value[i]`, every entry 'not run':
+    NaN (floats), −1 (ints), False (bools)."""
+    shape = (trials, *value.shape[1:])
+    if value.dtype == bool:
+        return np.zeros(shape, dtype=bool)
+    if np.issubdtype(value.dtype, np.integer):
+        return np.full(shape, -1, dtype=value.dtype)
+    return np.full(shape, np.nan, dtype=value.dtype)
+
+
 def _to_plain(value: Any) -> Any:
     if isinstance(value, np.ndarray):
         return value.tolist()
@@ -401,104 +453,6 @@ def _to_plain(value: Any) -> Any:
 
 
 def environment() -> dict[str, Any]:
-    """Package and dependency versions, git revision if known, Python, platform, CPU model,
-    threads. The CPU matters for reproducing numbers: the same seed gives the same results on
-    one machine, but the physics' f32 maths (glibc picks CPU-specific sin/cos/exp) may differ
-    in the last bits on another CPU, and RL runs amplify that."""
-    from importlib import metadata  # (and its email parsers): loaded by a run, not by `--help`
-
-    versions: dict[str, str | None] = {}
-    for name in ("latentrl", "numpy", "scipy", "matplotlib"):
-        try:
-            versions[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            versions[name] = None
-    return {
-        "results_format": RESULTS_FORMAT,
-        "versions": versions,
-        "python": platform.python_version(),
-        "platform": platform.platform(),
-        "cpu": _cpu_model(),
-        "cpu_flags": _cpu_flags(),
-        "blas": _blas(),
-        "git_revision": _git_revision(),
-        "cpu_count": os.cpu_count(),
-        "rayon_threads": worker_threads(),
-    }
-
-
-def _cpu_model() -> str:
-    """The CPU's model name (Linux: /proc/cpuinfo), else `platform.processor()`."""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor()
-
-
-SIMD_FLAGS = ("sse4_2", "avx", "avx2", "fma", "avx512f", "avx512dq", "avx512vl")
-"""The CPU features that change floating-point results here (libm and BLAS kernels pick by them)."""
-
-
-def _cpu_flags() -> list[str]:
-    """Which of SIMD_FLAGS the CPU has (Linux: /proc/cpuinfo; empty elsewhere)."""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("flags"):
-                have = set(line.split(":", 1)[1].split())
-                return [flag for flag in SIMD_FLAGS if flag in have]
-    except OSError:
-        pass
-    return []
-
-
-def _blas() -> dict[str, Any]:
-    """NumPy's BLAS (name, version, build configuration) and an OPENBLAS_CORETYPE override: the
-    GPLVM fit's last bits depend on the kernel OpenBLAS picks for the CPU."""
-    config: dict[str, Any] = {}
-    try:
-        config = dict(np.show_config(mode="dicts")["Build Dependencies"]["blas"])
-    except (KeyError, TypeError):
-        pass
-    return {
-        "name": config.get("name"),
-        "version": config.get("version"),
-        "configuration": config.get("openblas configuration"),
-        "OPENBLAS_CORETYPE": os.environ.get("OPENBLAS_CORETYPE"),
-    }
-
-
-def worker_threads() -> int:
-    """Threads the native trial runners use, as rayon picks them: RAYON_NUM_THREADS if it is a
-    positive integer, else the CPUs this process may run on. Runs are split into chunks of this
-    many trials; the results do not depend on it."""
-    try:
-        requested = int(os.environ.get("RAYON_NUM_THREADS", ""))
-    except ValueError:
-        requested = 0
-    if requested > 0:
-        return requested
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-
-
-def peak_rss_mib() -> float:
-    """Peak resident memory of this process so far, MiB (`getrusage`; Linux reports KiB)."""
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    return peak / (1024 * 1024 if platform.system() == "Darwin" else 1024)
-
-
-def _git_revision() -> str | None:
-    try:
-        out = subprocess.run(
-            ["git", "rev-parse", "HEAD"],
-            cwd=Path(__file__).resolve().parent,
-            capture_output=True,
-            text=True,
-            timeout=5,
-            check=True,
-        )
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return out.stdout.strip() or None
+    """What results.json records of the run's machine: the results layout's version, then
+    `latentrl.machine.machine()`."""
+    return {"results_format": RESULTS_FORMAT, **machine()}

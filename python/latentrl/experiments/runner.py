@@ -18,8 +18,8 @@ from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
+from latentrl.machine import peak_rss_mib, worker_threads
 from latentrl.run_lock import run_lock
-from latentrl.task import end_counts
 from latentrl.experiments.presets import describe
 from latentrl.experiments.results import (
     PER_EPISODE,
@@ -29,8 +29,9 @@ from latentrl.experiments.results import (
     array_key,
     as_saved,
     environment,
-    peak_rss_mib,
-    worker_threads,
+    not_run,
+    not_run_like,
+    summarise_trial,
     write_json,
     write_npz,
 )
@@ -151,7 +152,7 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
             meta = {"preset": plan, "environment": environment(), "setup": built.info, "wall_time_s": 0.0}
         for name in built.learners:
             for key in PER_EPISODE:
-                arrays.setdefault(array_key(name, key), _empty(key, preset.trials, preset.episodes))
+                arrays.setdefault(array_key(name, key), not_run(key, preset.trials, preset.episodes))
         todo = [
             (name, t)
             for name in built.learners
@@ -168,7 +169,7 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
                     for key in PER_TRIAL:
                         value = result.get(key)
                         if value is not None and value[i].size:
-                            arrays.setdefault(array_key(name, key), _unset(value, preset.trials))[t] = value[i]
+                            arrays.setdefault(array_key(name, key), not_run_like(value, preset.trials))[t] = value[i]
                     meta["trials"].setdefault(name, {})[str(t)] = summarise_trial(arrays, name, t)
                 meta["wall_time_s"] += time.perf_counter() - started
                 meta["peak_rss_mib"] = max(meta.get("peak_rss_mib", 0.0), peak_rss_mib())
@@ -187,58 +188,6 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
         raise type(err)(err.errno, f"{err.strerror or err}; the run's results are saved in {out}: `latentrl plot "
                                    f"{out}` draws its figures again") from err
     return meta
-
-
-def summarise_trial(arrays: Mapping[str, np.ndarray], name: str, trial: int) -> dict[str, Any]:
-    """Per-trial figures for results.json: early/late mean return, end counts, reach and pass
-    rates over the episodes the trial ran (a trial the stopping rule ended ran fewer than its
-    budget; the rest are unset, end −1); with frozen test episodes also `test_success` (share
-    that reached the target), `test_passed`, their mean return and end counts."""
-    ends = arrays[array_key(name, "ends")][trial]
-    ran = int((ends >= 0).sum()) or len(ends)
-    ends = ends[:ran]
-    returns = arrays[array_key(name, "returns")][trial][:ran]
-    reached = arrays[array_key(name, "reached")][trial][:ran]
-    passed = arrays[array_key(name, "passed")][trial][:ran]
-    window = max(1, len(returns) // 10)
-    summary: dict[str, Any] = {
-        "mean_return_first": float(returns[:window].mean()),
-        "mean_return_last": float(returns[-window:].mean()),
-        "reached_last": float(reached[-window:].mean()),
-        "passed_last": float(passed[-window:].mean()),
-        "window": window,
-        "ends": end_counts(ends),
-    }
-    if array_key(name, "test_ends") in arrays:
-        test_ends = arrays[array_key(name, "test_ends")][trial]
-        summary.update(
-            test_success=float(arrays[array_key(name, "test_reached")][trial].mean()),
-            test_passed=float(arrays[array_key(name, "test_passed")][trial].mean()),
-            test_mean_return=float(arrays[array_key(name, "test_returns")][trial].mean()),
-            test_ends=end_counts(test_ends),
-        )
-    return summary
-
-
-def _empty(key: str, trials: int, episodes: int) -> np.ndarray:
-    if key == "returns":
-        return np.full((trials, episodes), np.nan)
-    if key == "ends":
-        return np.full((trials, episodes), -1, dtype=np.int8)
-    if key == "reached":
-        return np.zeros((trials, episodes), dtype=bool)
-    return np.zeros((trials, episodes), dtype=np.int64)
-
-
-def _unset(value: np.ndarray, trials: int) -> np.ndarray:
-    """A (trials, …) array for per-trial rows like `value[i]`, every entry 'not run':
-    NaN (floats), −1 (ints), False (bools)."""
-    shape = (trials, *value.shape[1:])
-    if value.dtype == bool:
-        return np.zeros(shape, dtype=bool)
-    if np.issubdtype(value.dtype, np.integer):
-        return np.full(shape, -1, dtype=value.dtype)
-    return np.full(shape, np.nan, dtype=value.dtype)
 
 
 def _chunks(todo: list[tuple[str, int]], size: int) -> list[tuple[str, int, int]]:
