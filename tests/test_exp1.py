@@ -12,23 +12,12 @@ from latentrl.experiments.exp1 import Exp1Preset
 from latentrl.experiments import run_experiment
 from latentrl.run_settings import with_overrides
 from latentrl.experiments.runner import run_rl
-from learning import assert_separated, control
+from learning import assert_separated
+
+EXPERIMENT = "exp1"
+"""The experiment of `quick_run` and `control_run` (conftest.py)."""
 
 TINY = with_overrides(Exp1Preset.quick(), {"trials": 2, "episodes": 40, "plant.max_steps": 100})
-
-
-@pytest.fixture(scope="module")
-def quick_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("exp1_quick")
-    meta = run_experiment("exp1", Exp1Preset.quick(), out, progress=False)
-    return out, meta
-
-
-@pytest.fixture(scope="module")
-def control_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("exp1_control")
-    run_experiment("exp1", control(Exp1Preset.quick()), out, progress=False)
-    return out
 
 
 def test_quick_preset_latent_learner_learns_and_never_drops(quick_run, control_run):

@@ -17,7 +17,10 @@ from latentrl.experiments.exp2 import Exp2Preset
 from latentrl.experiments import run_experiment
 from latentrl.run_settings import with_overrides
 from latentrl.experiments.results import write_npz
-from learning import assert_separated, control
+from learning import assert_separated
+
+EXPERIMENT = "exp2"
+"""The experiment of `quick_run` and `control_run` (conftest.py)."""
 
 TINY = with_overrides(Exp2Preset.quick(), {"trials": 2, "episodes": 6, "episode.max_steps": 60, "test_episodes": 3})
 
@@ -119,20 +122,6 @@ def test_a_rollout_is_frozen_and_repeats(fitted, policy):
     np.testing.assert_array_equal(once["returns"], again["returns"])
     with pytest.raises(ValueError, match='rollout must be one of greedy | softmax | random, got "best"'):
         run_task_trials(arms()._native, **{**kwargs, "rollout": "best"})
-
-
-@pytest.fixture(scope="module")
-def quick_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("exp2_quick")
-    meta = run_experiment("exp2", Exp2Preset.quick(), out, progress=False)
-    return out, meta
-
-
-@pytest.fixture(scope="module")
-def control_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("exp2_control")
-    run_experiment("exp2", control(Exp2Preset.quick()), out, progress=False)
-    return out
 
 
 def test_quick_preset_passes_the_corridor_and_reaches_the_target(quick_run, control_run):

@@ -17,7 +17,10 @@ from latentrl.experiments.exp3 import Exp3Preset
 from latentrl.experiments import run_experiment
 from latentrl.run_settings import with_overrides
 from latentrl.experiments.results import write_npz
-from learning import assert_separated, control
+from learning import assert_separated
+
+EXPERIMENT = "exp3"
+"""The experiment of `quick_run` and `control_run` (conftest.py)."""
 
 TINY = with_overrides(Exp3Preset.quick(), {"trials": 2, "episodes": 3, "episode.max_steps": 8, "test_episodes": 1,
                                            "map_grid": 8})
@@ -55,13 +58,6 @@ def test_runs_record_postures_and_echo_the_task(fitted):
     assert config["servo"]["kp"] == 8.0 and config["servo"]["max_force"] == 1.2 and config["episode"]["max_steps"] == 5
 
 
-@pytest.fixture(scope="module")
-def quick_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("exp3_quick")
-    meta = run_experiment("exp3", Exp3Preset.quick(), out, progress=False)
-    return out, meta
-
-
 def test_quick_preset_ends_episodes_correctly(quick_run):
     """Finite returns within the reward's bounds, every episode ended by a known code, a
     terminal step (obstacle, box, drop, fall) carries the −1 and a time-out ran all steps."""
@@ -81,13 +77,6 @@ def test_quick_preset_ends_episodes_correctly(quick_run):
     assert (ends == 0).mean() >= 0.4, "fewer than 40 % of episodes ran to the time-out"
     for summary in meta["trials"]["latent"].values():
         assert sum(summary["ends"].values()) == preset.episodes
-
-
-@pytest.fixture(scope="module")
-def control_run(tmp_path_factory):
-    out = tmp_path_factory.mktemp("exp3_control")
-    run_experiment("exp3", control(Exp3Preset.quick()), out, progress=False)
-    return out
 
 
 def test_quick_preset_learns(quick_run, control_run):
