@@ -120,14 +120,15 @@ def write_bag(path: Path, frames: np.ndarray, names=NAMES, *, ros: int = 1, topi
     return path
 
 
-def arm_episodes(frames: int, per_episode: int = 1000, seed: int = 0) -> list[np.ndarray]:
+def arm_episodes(frames: int, per_episode: int = 1000, seed: int = 0, offset: float = 0.0) -> list[np.ndarray]:
     """`frames` frames of smooth reaching motions of a 7-joint arm (radians) and its gripper
-    (metres), in episodes of `per_episode`."""
+    (metres), in episodes of `per_episode`; with `offset`, each frame that many steps later in
+    time (0.5: halfway between two recorded frames)."""
     rng = np.random.default_rng(seed)
     episodes = []
     for start in range(0, frames, per_episode):
         n = min(per_episode, frames - start)
-        t = np.linspace(0, 1, n)[:, None]
+        t = (np.linspace(0, 1, n) + offset / max(n - 1, 1))[:, None]
         a, b = rng.uniform(-1.5, 1.5, (2, 7))
         arm = a + (b - a) * (3 * t**2 - 2 * t**3) + 0.05 * np.sin(2 * np.pi * rng.uniform(1, 3, 7) * t)
         episodes.append(np.column_stack([arm, 0.04 * (t[:, 0] > 0.5)]))

@@ -184,3 +184,21 @@ def test_second_stage_starts_from_the_lower_bound(postures: str) -> None:
         return float(_native.gplvm_nll_grad(z, centred, first.log_theta, inducing=first.inducing)[0])
 
     assert bound(latent) <= bound(encoded)
+
+
+def test_a_sparse_fit_stops_on_the_decrease_per_term() -> None:
+    """With `terms`, L-BFGS-B stops once an iteration decreases the objective by at most
+    tol × terms, where scipy's relative test (near an optimum at 0) asks almost nothing; up to
+    that iteration its iterates are scipy's own (docs/method.md §Sparse GPLVM)."""
+    from latentrl._nll_fit import lbfgs
+
+    def objective(x: np.ndarray) -> tuple[float, np.ndarray]:
+        return float(np.sum(np.cosh(x) - 1.0)), np.sinh(x)  # its minimum, 0, at x = 0
+
+    x0, bounds = np.linspace(1.0, 3.0, 50), [(None, None)] * 50
+    plain = lbfgs(objective, x0, bounds, max_iter=1000, tol=1e-6)
+    per_term = lbfgs(objective, x0, bounds, max_iter=1000, tol=1e-6, terms=100_000)
+    assert per_term.success and per_term.status == 0 and "TERMS" in per_term.message
+    assert per_term.nit < plain.nit and per_term.fun > plain.fun
+    capped = lbfgs(objective, x0, bounds, max_iter=per_term.nit, tol=1e-6)
+    np.testing.assert_array_equal(capped.x, per_term.x)

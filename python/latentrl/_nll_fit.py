@@ -4,6 +4,7 @@ hyper-parameters they share. SciPy loads at the first fit, not at `import latent
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -51,14 +52,30 @@ class NllFit:
 
 
 def lbfgs(objective: Callable[[NDArray[np.float64]], tuple[float, NDArray[np.float64]]], x0: NDArray[np.float64],
-          bounds: Sequence[tuple[float | None, float | None]], *, max_iter: int, tol: float) -> Any:
-    """scipy's L-BFGS-B on `objective` (value and gradient), stopping when the relative decrease
-    of the objective or the largest projected gradient falls below `tol`, or after `max_iter`
-    iterations: the one optimiser call of every likelihood fit here."""
-    from scipy.optimize import minimize
+          bounds: Sequence[tuple[float | None, float | None]], *, max_iter: int, tol: float, terms: int = 1) -> Any:
+    """scipy's L-BFGS-B on `objective` (value and gradient), stopping when an iteration decreases
+    the objective by less than `tol` × max(|objective|, `terms`) or the largest projected gradient
+    component falls below `tol`, or after `max_iter` iterations: the one optimiser call of every
+    likelihood fit here. `terms`, the number of terms the objective sums, is its scale where its
+    value is near 0 (docs/method.md §Sparse GPLVM); scipy's own floor is 1."""
+    from scipy.optimize import OptimizeResult, minimize
 
-    return minimize(objective, x0, jac=True, method="L-BFGS-B", bounds=bounds,
-                    options={"maxiter": max_iter, "ftol": tol, "gtol": tol})
+    last = {"fun": math.inf, "stopped": False}
+
+    def per_term(intermediate_result: OptimizeResult) -> None:
+        # Called at each new iterate before scipy's own test of it, so a stop here leaves the
+        # iterate scipy's rule would have left, had its floor been `terms`.
+        if last["fun"] - intermediate_result.fun <= tol * terms:
+            last["stopped"] = True
+            raise StopIteration
+        last["fun"] = intermediate_result.fun
+
+    res = minimize(objective, x0, jac=True, method="L-BFGS-B", bounds=bounds, callback=per_term if terms > 1 else None,
+                   options={"maxiter": max_iter, "ftol": tol, "gtol": tol})
+    if last["stopped"]:
+        res.status, res.success = 0, True
+        res.message = f"CONVERGENCE: REDUCTION_OF_F_<=_TOL*{terms}_TERMS"
+    return res
 
 
 def minimise_nll(
@@ -80,7 +97,7 @@ def minimise_nll(
     objective or the largest projected gradient falls below `tol`, or after `max_iter`
     iterations (then `converged` is False). With `inducing` (m, d) the objective is the sparse
     (DTC) bound through those inducing inputs (docs/method.md §Sparse GPLVM), optimised with the
-    inputs if `fit_latent` (else held fixed)."""
+    inputs if `fit_latent` (else held fixed), and its decrease is relative to max(|bound|, N·D)."""
     n, d = latent.shape
     # The points L-BFGS moves: the latent points, then the inducing inputs (the native
     # gradient's row order); the data term alone with fixed inputs.
@@ -123,7 +140,7 @@ def minimise_nll(
         from threadpoolctl import threadpool_limits
 
         with threadpool_limits(limits=1, user_api="blas"):
-            res = lbfgs(objective, x0, bounds, max_iter=max_iter, tol=tol)
+            res = lbfgs(objective, x0, bounds, max_iter=max_iter, tol=tol, terms=data.size)
     points, lt = split(res.x)
     return NllFit(
         np.array(points[:n]),

@@ -78,8 +78,9 @@ class GPLVM(Estimator):
         commanded (reconstruction error only), so a posture the plant tracked keeps its point
         (docs/encoders.md); `transform`, which has no commanded point, projects.
     tol : float, default=1e-6
-        L-BFGS-B stops when the relative decrease of the objective (ftol) or the largest
-        projected gradient component (gtol) falls below `tol` (scipy's `tol`).
+        L-BFGS-B stops when the relative decrease of the objective (ftol; a sparse fit's
+        relative to max(|bound|, N·D), docs/method.md §Sparse GPLVM) or the largest projected
+        gradient component (gtol) falls below `tol` (scipy's `tol`).
     inducing : int or None, default=None
         None: the exact GPLVM (O(N³) per step, at most `_native.MAX_GP_POINTS` postures). An int
         m (1 ≤ m ≤ N): the sparse GPLVM, the DTC bound through m inducing inputs (docs/method.md
