@@ -567,6 +567,11 @@ mod tests {
         let map = GpMap::sparse(u.clone(), &latent, &data, kernel).unwrap();
         assert_eq!(map.len(), 4);
         let (means, vars) = map.predict(&queries).unwrap();
+        for (j, var) in vars.iter().enumerate() {
+            let mut mean = vec![0.0; data.nrows()];
+            let one = map.predict_into(queries.column(j).as_slice(), &mut mean, &mut map.scratch());
+            assert_eq!((one, mean.as_slice()), (*var, means.column(j).as_slice()));
+        }
         let noise = kernel.noise;
         let kmm = kernel.cross(&u, &u);
         let kmn = kernel.cross(&u, &latent);
