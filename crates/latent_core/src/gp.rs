@@ -280,11 +280,19 @@ impl GpMap {
                 .for_each_init(
                     || (self.scratch(), BlockScratch::default()),
                     |(scratch, block), (b, (means_out, vars_out))| {
+                        // Full groups of LANES queries solve together; the rest (all of a batch
+                        // of one) one at a time, rather than solve a group of mostly empty lanes.
+                        let grouped = vars_out.len() - vars_out.len() % LANES;
                         for (j, mean_out) in means_out.chunks_mut(p).enumerate() {
-                            self.mean_into(queries.column(b * BLOCK + j).as_slice(), mean_out, scratch);
-                            block.set_kstar(j, &scratch.kstar);
+                            let x = queries.column(b * BLOCK + j);
+                            if j < grouped {
+                                self.mean_into(x.as_slice(), mean_out, scratch);
+                                block.set_kstar(j, &scratch.kstar);
+                            } else {
+                                vars_out[j] = self.predict_into(x.as_slice(), mean_out, scratch);
+                            }
                         }
-                        self.block_variances(block, vars_out);
+                        self.block_variances(block, &mut vars_out[..grouped]);
                     },
                 ),
             None => means.as_mut_slice().par_chunks_mut(p).enumerate().for_each_init(
@@ -325,7 +333,7 @@ const LANES: usize = 16;
 type Lanes = [f64; LANES];
 
 /// A block's `k*`s, by groups of [`LANES`] queries (a group's entry i of every query, then entry
-/// i + 1; the lanes past the last query 0), and a buffer of [`GpMap::block_variances`].
+/// i + 1), and a buffer of [`GpMap::block_variances`].
 #[derive(Debug, Default)]
 struct BlockScratch {
     kstar: Vec<Lanes>,

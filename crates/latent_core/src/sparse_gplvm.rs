@@ -567,10 +567,14 @@ mod tests {
         let map = GpMap::sparse(u.clone(), &latent, &data, kernel).unwrap();
         assert_eq!(map.len(), 4);
         let (means, vars) = map.predict(&queries).unwrap();
-        for (j, var) in vars.iter().enumerate() {
+        // A batch's variances, solved in groups of points (40: two groups and 8 one at a time),
+        // are the single point's to the bit.
+        let many = DMatrix::from_fn(2, 40, |i, j| (i as f64 - j as f64 * 0.1) * 0.35);
+        let (many_means, many_vars) = map.predict(&many).unwrap();
+        for (j, var) in many_vars.iter().enumerate() {
             let mut mean = vec![0.0; data.nrows()];
-            let one = map.predict_into(queries.column(j).as_slice(), &mut mean, &mut map.scratch());
-            assert_eq!((one, mean.as_slice()), (*var, means.column(j).as_slice()));
+            let one = map.predict_into(many.column(j).as_slice(), &mut mean, &mut map.scratch());
+            assert_eq!((one, mean.as_slice()), (*var, many_means.column(j).as_slice()));
         }
         let noise = kernel.noise;
         let kmm = kernel.cross(&u, &u);
