@@ -7,8 +7,8 @@
 //! They live here, beside the learner, because they know no plant: they size the run and make
 //! the latent space the learner acts in.
 
-use crate::params::{ParamError, Rule, join};
-use crate::trials::MAX_EPISODES;
+use crate::params::{ParamError, Params, Rule, join};
+use crate::trials::{MAX_EPISODES, records_over_limit};
 use crate::{choice, params};
 
 choice! {
@@ -83,8 +83,7 @@ fn run_rules(run: &RunConfig, path: &str) -> Result<(), ParamError> {
              of the postures; give \"fit\" or \"auto\" (which keeps them) with it",
         ));
     }
-    let records = run.trials as u128 * (run.episodes as u128 + run.test_episodes as u128);
-    if records > MAX_EPISODES as u128 {
+    if let Some(records) = records_over_limit(run.trials, run.episodes, run.test_episodes) {
         return Err(ParamError::new(
             &join(path, "trials"),
             format!(
@@ -96,10 +95,23 @@ fn run_rules(run: &RunConfig, path: &str) -> Result<(), ParamError> {
     Ok(())
 }
 
+impl RunConfig {
+    /// The bounds `[min, max]` of the count `key` (`trials`, `episodes`, …) by its rule above,
+    /// None for a key that is no count: a trial runner's arguments obey the same limits.
+    pub fn count_bounds(key: &str) -> Option<(u64, u64)> {
+        Self::fields()
+            .into_iter()
+            .find(|f| f.name == key)
+            .and_then(|f| match f.rule {
+                Rule::Count { min, max } => Some((min, max)),
+                _ => None,
+            })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::Params;
 
     #[test]
     fn defaults_pass_and_errors_name_the_key() {

@@ -25,6 +25,7 @@ use crate::error::{CoreError, Result};
 use crate::gp::GpMap;
 use crate::learner::{ActionRule, Learner, Phase};
 use crate::plant::Plant;
+use crate::run::RunConfig;
 use crate::space::StateSpace;
 
 /// The generator of trial `trial`: ChaCha8 seeded from `base_seed`, stream `trial`
@@ -128,28 +129,38 @@ fn int_in(name: &str, value: i128, min: i128, max: i128) -> Result<i128> {
     Ok(value)
 }
 
+/// `value` if it lies within the bounds of the `[run]` count `key` (its rule in [`RunConfig`],
+/// where they are defined once), else the error naming the runner's argument `name`.
+fn run_count(name: &str, key: &str, value: i128) -> Result<usize> {
+    let (min, max) =
+        RunConfig::count_bounds(key).ok_or_else(|| CoreError::Argument(format!("run.{key} is no count")))?;
+    Ok(int_in(name, value, min.into(), max.into())? as usize)
+}
+
+/// `trials × (episodes + test_episodes)` episode records if more than [`MAX_EPISODES`] (what one
+/// run holds in memory), else None: the rule of a runner's arguments and of a `[run]` table.
+pub fn records_over_limit(trials: usize, episodes: usize, test_episodes: usize) -> Option<u128> {
+    let records = trials as u128 * (episodes as u128 + test_episodes as u128);
+    (records > MAX_EPISODES as u128).then_some(records)
+}
+
 impl TrialOptions {
     /// The options of `args`, every argument checked against its limit (the messages name
-    /// the argument), and at most [`MAX_EPISODES`] episode records in all.
+    /// the argument; `n_trials`, `episodes` and `test_episodes` obey the `[run]` rules of
+    /// [`RunConfig`]), and at most [`MAX_EPISODES`] episode records in all.
     pub fn from_args(args: &RunArgs) -> Result<Self> {
-        let n_trials = int_in("n_trials", args.n_trials, 1, 1_000_000)? as usize;
-        let episodes = int_in("episodes", args.episodes, 1, 100_000_000)? as usize;
+        let n_trials = run_count("n_trials", "trials", args.n_trials)?;
+        let episodes = run_count("episodes", "episodes", args.episodes)?;
         let base_seed = int_in("base_seed", args.base_seed, 0, u64::MAX as i128)? as u64;
         let first_trial = match args.first_trial {
             Some(v) => int_in("first_trial", v, 0, 1 << 40)? as usize,
             None => 0,
         };
         let test_episodes = match args.test_episodes {
-            Some(v) => int_in("test_episodes", v, 0, 100_000_000)? as usize,
+            Some(v) => run_count("test_episodes", "test_episodes", v)?,
             None => 0,
         };
-        let total = n_trials as u128 * (episodes + test_episodes) as u128;
-        if total > MAX_EPISODES as u128 {
-            return argument(format!(
-                "n_trials × (episodes + test_episodes) = {total} episode records in one call, more than {MAX_EPISODES}; \
-                 run fewer trials at a time (the runners save trial by trial)"
-            ));
-        }
+        check_records(n_trials, episodes, test_episodes)?;
         let indices = |name: &str, list: &[i128], n: usize| -> Result<Vec<usize>> {
             let name = format!("{name}[i]");
             list.iter()
@@ -198,22 +209,13 @@ impl TrialOptions {
         Ok(())
     }
 
-    /// Checks `n_trials, episodes ≥ 1` and that every recorded (test) episode exists.
+    /// Checks `n_trials`, `episodes` and `test_episodes` by the `[run]` rules, the episode
+    /// records in all, and that every recorded (test) episode exists.
     pub fn validate(&self) -> Result<()> {
-        if self.n_trials == 0 {
-            return Err(CoreError::InvalidParameter {
-                name: "n_trials",
-                value: 0.0,
-                reason: "must be at least 1",
-            });
-        }
-        if self.episodes == 0 {
-            return Err(CoreError::InvalidParameter {
-                name: "episodes",
-                value: 0.0,
-                reason: "must be at least 1",
-            });
-        }
+        run_count("n_trials", "trials", self.n_trials as i128)?;
+        run_count("episodes", "episodes", self.episodes as i128)?;
+        run_count("test_episodes", "test_episodes", self.test_episodes as i128)?;
+        check_records(self.n_trials, self.episodes, self.test_episodes)?;
         if self.first_trial.checked_add(self.n_trials).is_none() {
             return Err(CoreError::InvalidParameter {
                 name: "first_trial",
@@ -236,6 +238,17 @@ impl TrialOptions {
             });
         }
         Ok(())
+    }
+}
+
+/// Refuses more than [`MAX_EPISODES`] episode records in one call ([`records_over_limit`]).
+fn check_records(n_trials: usize, episodes: usize, test_episodes: usize) -> Result<()> {
+    match records_over_limit(n_trials, episodes, test_episodes) {
+        Some(total) => argument(format!(
+            "n_trials × (episodes + test_episodes) = {total} episode records in one call, more than {MAX_EPISODES}; \
+             run fewer trials at a time (the runners save trial by trial)"
+        )),
+        None => Ok(()),
     }
 }
 
@@ -805,6 +818,21 @@ mod tests {
             assert_eq!(calls.load(Ordering::Relaxed), 10, "refuse = {refuse}");
             assert!(trial.episodes.is_empty() && done.load(Ordering::Relaxed) == 0);
         }
+    }
+
+    #[test]
+    fn runner_limits_are_the_run_tables() {
+        let args = |n_trials, episodes| RunArgs {
+            n_trials,
+            episodes,
+            ..RunArgs::default()
+        };
+        let message = |a: RunArgs| TrialOptions::from_args(&a).unwrap_err().to_string();
+        assert_eq!(message(args(0, 5)), "n_trials must lie in [1, 1000000], got 0");
+        assert_eq!(message(args(1, -3)), "episodes must lie in [1, 100000000], got -3");
+        assert!(message(args(1000, 100_000)).contains("= 100000000 episode records in one call, more than 10000000"));
+        assert_eq!(RunConfig::count_bounds("test_episodes"), Some((0, 100_000_000)));
+        assert_eq!(RunConfig::count_bounds("seed"), None);
     }
 
     #[test]
