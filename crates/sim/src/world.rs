@@ -54,6 +54,13 @@ pub struct World {
     filter: filter::PairFilter,
 }
 
+impl std::fmt::Display for World {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (robot, joints, dt) = (self.model.name(), self.num_joints(), self.rl_dt());
+        write!(f, "Sim(robot={robot:?}, joints={joints}, dt={dt})")
+    }
+}
+
 impl World {
     /// Builds the world: every joint at zero (clamped into its limits), servos holding
     /// that posture, optional floor. Fails on a configuration value that breaks its rule or a

@@ -483,12 +483,14 @@ impl SchemaTable {
     }
 }
 
-/// One settable key: what `_native.task_schema()` lists.
-#[derive(Debug, Clone, PartialEq)]
+/// One settable key: what `_native.task_schema()` lists (each as a dict of these fields but its
+/// name, which its key path ends with).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SchemaEntry {
     /// Its key path (`learner.gamma`, `constraints[].kind`).
     pub key: String,
     /// Its name in its table.
+    #[serde(skip)]
     pub name: &'static str,
     /// Its meaning.
     pub doc: String,
