@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use latent_core::trials::{Corner, LatentArgs};
 use latent_core::{GpMap, ResultArray, RunArgs, TrialOptions};
 use numpy::{PyArray1, PyArrayMethods};
+use pyo3::conversion::FromPyObjectOwned;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -23,30 +24,21 @@ pub(crate) fn invalid(msg: String) -> PyErr {
     InvalidInputError::new_err(msg)
 }
 
-/// A Python int.
-fn int(name: &str, value: &Bound<'_, PyAny>) -> PyResult<i128> {
+/// `value` as a `T`, or the error naming `name` and what it should be.
+fn arg<'py, T: FromPyObjectOwned<'py>>(name: &str, what: &str, value: &Bound<'py, PyAny>) -> PyResult<T> {
     value
         .extract()
-        .map_err(|_| invalid(format!("{name}: expected an int, got {}", type_name(value))))
+        .map_err(|_| invalid(format!("{name}: expected {what}, got {}", type_name(value))))
 }
 
-/// A Python int, or None for None.
-fn optional_int(name: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<i128>> {
-    value.filter(|v| !v.is_none()).map(|v| int(name, v)).transpose()
-}
-
-/// A sequence of Python ints, or empty for None.
-fn ints(name: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<i128>> {
-    let extract = |v: &Bound<'_, PyAny>| {
-        v.extract()
-            .map_err(|_| invalid(format!("{name}: expected a sequence of ints, got {}", type_name(v))))
-    };
-    value.filter(|v| !v.is_none()).map_or(Ok(Vec::new()), extract)
+/// `value` unless it is None.
+fn given<'a, 'py>(value: Option<&'a Bound<'py, PyAny>>) -> Option<&'a Bound<'py, PyAny>> {
+    value.filter(|v| !v.is_none())
 }
 
 /// A GpMap argument, or None.
 pub(crate) fn gp_map<'a, 'py>(name: &str, value: Option<&'a Bound<'py, PyAny>>) -> PyResult<Option<&'a GpMap>> {
-    match value.filter(|v| !v.is_none()) {
+    match given(value) {
         None => Ok(None),
         Some(v) => v
             .cast::<PyGpMap>()
@@ -57,9 +49,7 @@ pub(crate) fn gp_map<'a, 'py>(name: &str, value: Option<&'a Bound<'py, PyAny>>) 
 
 /// A corner of the latent box: its numbers, or the name of its type; None for None.
 pub(crate) fn corner(value: Option<&Bound<'_, PyAny>>) -> Option<Corner> {
-    value
-        .filter(|v| !v.is_none())
-        .map(|v| v.extract::<Vec<f64>>().map_err(|_| type_name(v)))
+    given(value).map(|v| v.extract::<Vec<f64>>().map_err(|_| type_name(v)))
 }
 
 /// The latent maps and box as given (an encoder of the wrong type is refused here).
@@ -94,13 +84,16 @@ impl<'py> RunArguments<'_, 'py> {
     /// The trial options (checked by the core; `rollout` as `RunArgs::rollout`) and the
     /// progress callback.
     pub(crate) fn check(self, rollout: Option<(String, bool)>) -> PyResult<(TrialOptions, Option<Bound<'py, PyAny>>)> {
+        let int = |name, value| arg(name, "an int", value);
+        let optional = |name, value| given(value).map(|v| int(name, v)).transpose();
+        let ints = |name, value| given(value).map_or(Ok(Vec::new()), |v| arg(name, "a sequence of ints", v));
         let args = RunArgs {
             n_trials: int("n_trials", self.n_trials)?,
             episodes: int("episodes", self.episodes)?,
             base_seed: int("base_seed", self.base_seed)?,
-            first_trial: optional_int("first_trial", self.first_trial)?,
+            first_trial: optional("first_trial", self.first_trial)?,
             record_episodes: ints("record_episodes", self.record_episodes)?,
-            test_episodes: optional_int("test_episodes", self.test_episodes)?,
+            test_episodes: optional("test_episodes", self.test_episodes)?,
             record_test_episodes: ints("record_test_episodes", self.record_test_episodes)?,
             keep_weights: self.return_weights,
             rollout,

@@ -105,14 +105,14 @@ impl PySim {
 
     #[pyo3(signature = (n = None))]
     fn step(&mut self, py: Python<'_>, n: Option<i64>) -> PyResult<()> {
-        let steps = match n {
-            None => self.inner.config().physics.substeps,
-            Some(n) => usize::try_from(n)
-                .map_err(|_| InvalidInputError::new_err(format!("n: expected an int >= 0 or None, got {n}")))?,
-        };
-        let inner = &mut self.inner;
         guard(|| {
-            py.detach(|| inner.step(steps));
+            let wrong = |n| InvalidInputError::new_err(format!("n: expected an int >= 0 or None, got {n}"));
+            let n = n.map(|n| usize::try_from(n).map_err(|_| wrong(n))).transpose()?;
+            let inner = &mut self.inner;
+            py.detach(|| match n {
+                Some(n) => inner.step(n),
+                None => inner.step_rl(),
+            });
             Ok(())
         })
     }
@@ -152,21 +152,12 @@ impl PySim {
 
     fn contacts(&self) -> PyResult<Vec<(String, usize)>> {
         guard(|| {
-            Ok(self
-                .inner
-                .contacts()
-                .into_iter()
-                .map(|c| (c.link, c.obstacle))
-                .collect())
+            let contacts = self.inner.contacts();
+            Ok(contacts.into_iter().map(|c| (c.link, c.obstacle)).collect())
         })
     }
 
     fn __repr__(&self) -> String {
-        format!(
-            "Sim(robot={:?}, joints={}, dt={})",
-            self.inner.model().name(),
-            self.inner.num_joints(),
-            self.inner.rl_dt()
-        )
+        self.inner.to_string()
     }
 }
