@@ -34,6 +34,16 @@ pub fn fixed<const LEN: usize>(name: &str, array: &PyReadonlyArray1<'_, f64>) ->
     })
 }
 
+/// Rows of a `(N, D)` array of postures, or None.
+pub fn rows(name: &str, array: Option<PyReadonlyArray2<'_, f64>>) -> PyResult<Option<Vec<Vec<f64>>>> {
+    array
+        .map(|a| {
+            let m = points(name, &a)?;
+            Ok(m.column_iter().map(|c| c.iter().copied().collect()).collect())
+        })
+        .transpose()
+}
+
 /// q×N matrix → `(N, q)` array, without copying the buffer.
 pub fn to_points<'py>(py: Python<'py>, matrix: DMatrix<f64>) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let (q, n) = matrix.shape();

@@ -8,45 +8,39 @@ mod errors;
 mod fallcheck;
 mod gp;
 mod kinematics;
+mod plant;
+mod policy;
 mod projection;
 mod runner;
+mod schema;
 mod task;
 mod urdf;
 mod world;
 
-use pyo3::prelude::*;
+#[pyo3::pymodule]
+mod _native {
+    use pyo3::prelude::*;
 
-#[pymodule]
-fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    errors::register(m)?;
-    m.add("MAX_GP_POINTS", latent_core::gp::MAX_GP_POINTS)?;
-    m.add("MAX_EPISODES", latent_core::trials::MAX_EPISODES)?;
-    m.add_class::<gp::PyGpMap>()?;
-    m.add_class::<projection::PyProjection>()?;
-    m.add_class::<world::PySim>()?;
-    m.add_class::<task::PyTask>()?;
-    m.add_class::<task::PyTaskPlant>()?;
-    m.add_class::<task::PyLatentPolicy>()?;
-    m.add_class::<bimanual::PyBimanualPlant>()?;
-    m.add_function(wrap_pyfunction!(gp::gplvm_nll_grad, m)?)?;
-    m.add_function(wrap_pyfunction!(gp::gplvm_back_constrained_nll_grad, m)?)?;
-    m.add_function(wrap_pyfunction!(kinematics::arms_fk, m)?)?;
-    m.add_function(wrap_pyfunction!(kinematics::arms_elbows, m)?)?;
-    m.add_function(wrap_pyfunction!(kinematics::arms_ik, m)?)?;
-    m.add_function(wrap_pyfunction!(kinematics::grip_error, m)?)?;
-    m.add_function(wrap_pyfunction!(fallcheck::fall_check, m)?)?;
-    m.add_function(wrap_pyfunction!(bimanual::run_bimanual_trials, m)?)?;
-    m.add_function(wrap_pyfunction!(bimanual::bimanual_config, m)?)?;
-    m.add_function(wrap_pyfunction!(bimanual::latent_refusal, m)?)?;
-    m.add_function(wrap_pyfunction!(task::bimanual_schema, m)?)?;
-    m.add_function(wrap_pyfunction!(task::run_task_trials, m)?)?;
-    m.add_function(wrap_pyfunction!(task::latent_survey, m)?)?;
-    m.add_function(wrap_pyfunction!(task::learner_values, m)?)?;
-    m.add_function(wrap_pyfunction!(task::task_schema, m)?)?;
-    m.add_function(wrap_pyfunction!(task::run_config, m)?)?;
-    m.add_function(wrap_pyfunction!(task::end_reasons, m)?)?;
-    m.add_function(wrap_pyfunction!(urdf::urdf_info, m)?)?;
-    m.add_function(wrap_pyfunction!(urdf::demo_columns, m)?)?;
-    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    Ok(())
+    #[pymodule_export]
+    use super::bimanual::{PyBimanualPlant, bimanual_config, latent_refusal, run_bimanual_trials};
+    #[pymodule_export]
+    use super::gp::{PyGpMap, gplvm_back_constrained_nll_grad, gplvm_nll_grad};
+    #[pymodule_export]
+    use super::kinematics::{arms_elbows, arms_fk, arms_ik, grip_error};
+    #[pymodule_export]
+    use super::schema::{bimanual_schema, end_reasons, run_config, task_schema};
+    #[pymodule_export]
+    use super::task::{PyTask, latent_survey, run_task_trials};
+    #[pymodule_export]
+    use super::{fallcheck::fall_check, plant::PyTaskPlant, policy::PyLatentPolicy, policy::learner_values};
+    #[pymodule_export]
+    use super::{projection::PyProjection, urdf::demo_columns, urdf::urdf_info, world::PySim};
+
+    #[pymodule_init]
+    fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
+        super::errors::register(m)?;
+        m.add("MAX_GP_POINTS", latent_core::gp::MAX_GP_POINTS)?;
+        m.add("MAX_EPISODES", latent_core::trials::MAX_EPISODES)?;
+        m.add("__version__", env!("CARGO_PKG_VERSION"))
+    }
 }
