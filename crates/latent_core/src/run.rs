@@ -8,7 +8,6 @@
 //! the latent space the learner acts in.
 
 use crate::params::{ParamError, Params, Rule, join};
-use crate::trials::{MAX_EPISODES, records_over_limit};
 use crate::{choice, params};
 
 choice! {
@@ -71,6 +70,16 @@ params! {
         latent_spacing: LatentSpacing = LatentSpacing::Auto => Rule::Any,
     }
     check = run_rules;
+}
+
+/// Most episode records one run or one runner call may hold (≈ 0.5 GB of per-episode arrays).
+pub const MAX_EPISODES: usize = 10_000_000;
+
+/// `trials × (episodes + test_episodes)` episode records if more than [`MAX_EPISODES`] (what one
+/// run holds in memory), else None: the rule of a runner's arguments and of a `[run]` table.
+pub fn records_over_limit(trials: usize, episodes: usize, test_episodes: usize) -> Option<u128> {
+    let records = trials as u128 * (episodes as u128 + test_episodes as u128);
+    (records > MAX_EPISODES as u128).then_some(records)
 }
 
 /// At most [`MAX_EPISODES`] episode records in one run (what it holds in memory); evenly spaced

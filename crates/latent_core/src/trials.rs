@@ -25,7 +25,7 @@ use crate::error::{CoreError, Result};
 use crate::gp::GpMap;
 use crate::learner::{ActionRule, Learner, Phase};
 use crate::plant::Plant;
-use crate::run::RunConfig;
+use crate::run::{MAX_EPISODES, RunConfig, records_over_limit};
 use crate::space::StateSpace;
 
 /// The generator of trial `trial`: ChaCha8 seeded from `base_seed`, stream `trial`
@@ -90,9 +90,6 @@ impl Default for TrialOptions {
     }
 }
 
-/// Most episode records one call may return (≈ 0.5 GB of per-episode arrays).
-pub const MAX_EPISODES: usize = 10_000_000;
-
 /// Most values of recorded paths one call may return (2 GiB of float64).
 pub const MAX_PATH_VALUES: usize = 1 << 28;
 
@@ -135,13 +132,6 @@ fn run_count(name: &str, key: &str, value: i128) -> Result<usize> {
     let (min, max) =
         RunConfig::count_bounds(key).ok_or_else(|| CoreError::Argument(format!("run.{key} is no count")))?;
     Ok(int_in(name, value, min.into(), max.into())? as usize)
-}
-
-/// `trials × (episodes + test_episodes)` episode records if more than [`MAX_EPISODES`] (what one
-/// run holds in memory), else None: the rule of a runner's arguments and of a `[run]` table.
-pub fn records_over_limit(trials: usize, episodes: usize, test_episodes: usize) -> Option<u128> {
-    let records = trials as u128 * (episodes as u128 + test_episodes as u128);
-    (records > MAX_EPISODES as u128).then_some(records)
 }
 
 impl TrialOptions {

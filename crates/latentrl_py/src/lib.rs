@@ -40,7 +40,7 @@ mod _native {
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
         super::errors::register(m)?;
         m.add("MAX_GP_POINTS", latent_core::gp::MAX_GP_POINTS)?;
-        m.add("MAX_EPISODES", latent_core::trials::MAX_EPISODES)?;
+        m.add("MAX_EPISODES", latent_core::run::MAX_EPISODES)?;
         m.add("__version__", env!("CARGO_PKG_VERSION"))
     }
 }
