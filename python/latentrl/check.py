@@ -32,7 +32,6 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from functools import cache
 from typing import Any
 
 import numpy as np
@@ -118,7 +117,7 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     module docs, with the settings `train` would derive where the task is silent; `model`: a
     fitted GPLVM (default: one fitted here, d = 2, as `train` fits); `latent_margin`: the
     box's margin (default: the task's `[run]`, else `TrainPreset`'s)."""
-    from latentrl.derive import SPACING, applied, derive
+    from latentrl.derive import SPACING, applied, derive, even_twin
     from latentrl.gplvm import GPLVM
     from latentrl.run_settings import TrainPreset, latent_box, with_task_run
 
@@ -129,10 +128,10 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     preset = with_task_run(TrainPreset(), task)
     even: Callable[[], Any] | None = None
     if model is None:  # fitted as `latentrl train` fits, its latent spacing derived as there
-        auto = preset.latent_spacing == "auto"
+        spacing = "fit" if preset.latent_spacing == "auto" else preset.latent_spacing
         model = GPLVM(n_components=2, random_state=preset.seed, max_iter=preset.gplvm_max_iter,
-                      encoder=preset.encoder, spacing="fit" if auto else preset.latent_spacing).fit(postures)
-        even = cache(model.evenly_spaced) if auto and preset.encoder != "back_constrained" else None
+                      encoder=preset.encoder, spacing=spacing).fit(postures)
+        even = even_twin(model, preset.latent_spacing)
     low, high = latent_box(model.Z_, preset.latent_margin if latent_margin is None else latent_margin)
     if demo_finding(task, postures).verdict != "will not learn":  # else nothing to derive from: say why
         derived = derive(task, model, low, high, postures, set(task.given), even)

@@ -34,6 +34,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
@@ -165,6 +166,21 @@ SPACING = "latent_spacing"
 SPACING_RULE = (f"the fit's own latent points leave no learner step at which the target region spans ≥ {SPAN:g} steps "
                 f"and 95 % of the starts reach it within 1/{FIT:g} of an episode: the GPLVM's points evenly spaced "
                 "along each axis (GPLVM(spacing='even'), docs/encoders.md)")
+
+
+def even_twin(model: Any, latent_spacing: str) -> Callable[[], Any] | None:
+    """The `even` argument of `derive` for `model`, a GPLVM fitted here with the run setting
+    `latent_spacing`: its evenly spaced twin, made once when asked, where the spacing is derived
+    ("auto"); None where it is not, or where the points cannot move (back-constrained)."""
+    if latent_spacing != "auto" or model.encoder == "back_constrained":
+        return None
+    return lambda: _evenly_spaced(model)
+
+
+@lru_cache(maxsize=1)
+def _evenly_spaced(model: Any) -> Any:
+    """`model.evenly_spaced()`, once per fit (a run's validation, setup and check share it)."""
+    return model.evenly_spaced()
 
 
 def servo_gains(task: Task, demos: NDArray[np.float64]) -> list[Derived]:

@@ -73,12 +73,6 @@ def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, mode
     return task, postures, gplvm
 
 
-@lru_cache(maxsize=1)
-def _evenly_spaced(model: GPLVM) -> GPLVM:
-    """`model.evenly_spaced()`, made once per fit (validation and setup share it)."""
-    return model.evenly_spaced()
-
-
 def fitted(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GPLVM]:
     """The task (with the run's overrides and the settings derived where they are silent), the
     demo postures and the GPLVM (fitted or loaded; with `out`, the one saved in that run
@@ -91,7 +85,7 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
     """`fitted`, and the settings `latentrl.derive` derived for it (cached per task, fit and
     margin). With `latent_spacing = "auto"` the fit's points are evenly spaced where the derive
     rule says so (`derive.SPACING`), before a new run saves its model."""
-    from latentrl.derive import SPACING, applied
+    from latentrl.derive import SPACING, applied, even_twin
     from latentrl.experiments.latent_runs import Fitted, run_fit
     from latentrl.experiments.results import RunFolder
 
@@ -104,7 +98,7 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
 
     auto = run.latent_spacing == "auto"
     task, demos, model = load("fit" if auto else run.latent_spacing)
-    even = (lambda: _evenly_spaced(model)) if auto and not run.model and run.encoder != "back_constrained" else None
+    even = None if run.model else even_twin(model, run.latent_spacing)
     if even is not None and any(d.key == SPACING for d in _derived(task, model, demos, run.latent_margin, even)):
         model = even()
     if out is not None:
