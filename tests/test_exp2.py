@@ -83,7 +83,7 @@ def test_mismatched_maps_raise_invalid_input(fitted):
         run_task_trials(arms()._native, **kwargs)
 
 
-def test_records_tests_and_task_echo(fitted):
+def test_records_tests_and_runs_a_task_from_its_dict(fitted):
     calls = []
     kwargs = arms_kwargs(fitted, record_episodes=[0, 2], test_episodes=4, record_test_episodes=[1],
                          return_weights=True, progress=lambda done, total: calls.append((done, total)))
@@ -106,7 +106,7 @@ def test_records_tests_and_task_echo(fitted):
     lower_hand = np.nan_to_num(np.minimum(path[:, 1:, 1], path[:, 1:, 4]), nan=-1.0)
     above = (lower_hand > 0.37).any(axis=1)
     np.testing.assert_array_equal(a["test_passed"][:, 1], above)
-    task = a["task"]
+    task = arms().to_dict()
     assert task["physics"]["solver_iterations"] == 2 and task["learner"]["alpha"] == 0.8
     assert task["learner"]["beta"] == 20.0 and task["episode"]["max_steps"] == 40
     assert [list(o["min"]) for o in task["obstacles"]] == [[-1.0, 0.30, -1.0], [-0.06, 0.30, -1.0]]

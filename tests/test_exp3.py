@@ -31,7 +31,7 @@ def fitted():
     return exp3.fit(Exp3Preset.quick())
 
 
-def test_runs_record_postures_and_echo_the_task(fitted):
+def test_runs_record_postures_of_the_given_task(fitted):
     task = exp3.task_of(with_overrides(TINY, {"episode.max_steps": 5}))
     a = run_task_trials(task._native, decoder=fitted.model.decoder_, encoder=fitted.model.encoder_,
                         latent_low=fitted.low, latent_high=fitted.high, demos=fitted.demos, n_trials=2, episodes=2,
@@ -53,7 +53,7 @@ def test_runs_record_postures_and_echo_the_task(fitted):
     for row in start:
         poses = plant.pose_links(row[base], row[rows["joints"]])
         np.testing.assert_allclose(poses[task.link_names.index("l_hand")][:3], row[:3], rtol=0, atol=1e-6)
-    config = a["task"]
+    config = task.to_dict()
     assert config["physics"]["solver_iterations"] == 2 and config["physics"]["pgs_iterations"] == 4
     assert config["servo"]["kp"] == 8.0 and config["servo"]["max_force"] == 1.2 and config["episode"]["max_steps"] == 5
 

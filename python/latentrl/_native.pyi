@@ -111,12 +111,13 @@ class Projection:
         *,
         max_iter: int = ...,
         margin: float = ...,
-        tracking: bool = False,
+        tracking: bool = ...,
     ) -> Projection:
         """The projection under `decoder` (a GpMap latent → posture) fitted to `postures` (N, D),
         with `max_iter` L-BFGS iterations per stage and the latent box widened by `margin`;
         `tracking`: after a move, search from the commanded latent point (docs/encoders.md).
-        Defaults are the core's (`ProjectionConfig::DEFAULT`: 200 iterations, margin 0.5)."""
+        Defaults are the core's (`ProjectionConfig::DEFAULT`: 200 iterations, margin 0.5, no
+        tracking)."""
     def encode(self, postures: NDArray[np.float64]) -> NDArray[np.float64]:
         """Latent points (M, d) of `postures` (M, D), in parallel."""
     def encode_one(self, posture: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -136,16 +137,17 @@ class Sim:
         cls,
         urdf: str | PathLike[str],
         *,
-        root: Literal["fixed", "floating"] = "fixed",
+        root: Literal["fixed", "floating"] = ...,
         floor: float | None = None,
         physics: Mapping[str, object] | None = None,
         servo: Mapping[str, object] | None = None,
-        balance_inertia: bool = False,
+        balance_inertia: bool = ...,
     ) -> Sim:
         """Builds the world from `urdf`: a path, or the URDF XML itself (a str starting with `<`).
-        `root` "fixed" or "floating"; `floor` the height of a floor half-space (normal +z) or
-        None; `physics` and `servo` dicts of the task file's `[physics]` and `[servo]` keys;
-        `balance_inertia` repairs inertias the physics cannot take (`urdf-info --balance-inertia`)."""
+        `root` "fixed" (default, `RootMode::default`) or "floating"; `floor` the height of a floor
+        half-space (normal +z) or None; `physics` and `servo` dicts of the task file's `[physics]`
+        and `[servo]` keys; `balance_inertia` repairs inertias the physics cannot take
+        (`urdf-info --balance-inertia`; off by default, `LoadOptions::default`)."""
     @property
     def joint_names(self) -> list[str]:
         """Names of the actuated joints, in the order of postures and targets."""
@@ -186,11 +188,12 @@ class Sim:
         center: NDArray[np.float64],
         half_extents: NDArray[np.float64],
         *,
-        sensor: bool = True,
-        name: str = "box",
+        sensor: bool = ...,
+        name: str = ...,
     ) -> int:
         """Adds a static axis-aligned box at `center` (3,) with `half_extents` (3,); returns its
-        id. A sensor (default) is passed through but still reported by `contacts`."""
+        id. A sensor (default) is passed through but still reported by `contacts`. Defaults are
+        a task file's obstacle's (`ObstacleConfig`: a sensor named "box")."""
     def contacts(self) -> list[tuple[str, int]]:
         """Every (link name, obstacle id) pair whose shapes are within the contact margin."""
 
@@ -221,9 +224,10 @@ def arms_ik(hands: NDArray[np.float64]) -> NDArray[np.float64]:
     """Postures `(N, 4)` (elbows outward, shoulder angles continuous in front of the body) that
     put the hands at `hands` `(N, 4)`; an unreachable row raises InvalidInputError."""
 
-def grip_error(hands: NDArray[np.float64], test: str = "distance") -> NDArray[np.float64]:
-    """Grip error `(N,)` in metres of hands `(N, 4)` by `test`: `"distance"`
-    `| ‖hand_R − hand_L‖ − 0.1 |` or `"vector"` `‖(hand_R − hand_L) − (0.1, 0)‖`."""
+def grip_error(hands: NDArray[np.float64], test: str = ...) -> NDArray[np.float64]:
+    """Grip error `(N,)` in metres of hands `(N, 4)` by `test`: `"distance"` (default,
+    `GripTest::DEFAULT`) `| ‖hand_R − hand_L‖ − 0.1 |` or `"vector"`
+    `‖(hand_R − hand_L) − (0.1, 0)‖`."""
 
 def fall_check(
     task: Task,
@@ -292,9 +296,8 @@ def run_bimanual_trials(
     likewise, "test_starts" (T, K, 4) the row at the start of every test episode (NaN where
     not run), "mean_states" (T, E, n) each training episode's mean learner state (n: 4 full,
     d latent; NaN where not run), "weights" (T, M) float64 or None, "learner_low" /
-    "learner_high" / "spacing" (d,) of the RBF grid, "n_actions", "n_centres", and "plant" /
-    "learner" (the effective configurations). Ctrl-C stops all trials and raises
-    KeyboardInterrupt."""
+    "learner_high" / "spacing" (d,) of the RBF grid, "n_actions", "n_centres" (the effective
+    configurations are `bimanual_config`'s). Ctrl-C stops all trials and raises KeyboardInterrupt."""
 
 def bimanual_config(
     plant: Mapping[str, object] | None = None, learner: Mapping[str, object] | None = None
@@ -341,9 +344,10 @@ class Task:
     def load(path: str | PathLike[str]) -> Task:
         """Reads a TOML task file (the URDF path relative to its folder)."""
     @staticmethod
-    def from_dict(config: Mapping[str, object], base_dir: str | PathLike[str] = ..., origin: str = "<dict>") -> Task:
-        """A task from a dict of task-file keys; the URDF path is relative to `base_dir`, `origin`
-        names the task in errors."""
+    def from_dict(config: Mapping[str, object], base_dir: str | PathLike[str] = ..., origin: str = ...) -> Task:
+        """A task from a dict of task-file keys; the URDF path is relative to `base_dir` (default
+        the working folder, `Task::CONFIG_BASE_DIR`), `origin` names the task in errors (default
+        "<dict>", `Task::CONFIG_ORIGIN`)."""
     def to_dict(self) -> dict[str, Any]:
         """Every key with its effective value, as a dict of task-file keys."""
     @property
@@ -490,7 +494,7 @@ def run_task_trials(
     record_test_episodes, return_weights, progress: as for run_bimanual_trials.
 
     Returns the dict of run_bimanual_trials with paths of `task.row_len` columns (effectors,
-    base pose, joints) and "task" (the effective task as a dict)."""
+    base pose, joints); the effective task is `task.to_dict()`."""
 
 def latent_survey(
     task: Task,
@@ -535,9 +539,9 @@ def run_config(run: Mapping[str, object] | None = None) -> dict[str, Any]:
 def bimanual_schema() -> list[dict[str, Any]]:
     """The keys of Experiment 1's configuration (`plant.*`, `learner.*`), as `task_schema`."""
 
-def urdf_info(path: str | PathLike[str], *, balance_inertia: bool = False) -> dict[str, Any]:
+def urdf_info(path: str | PathLike[str], *, balance_inertia: bool = ...) -> dict[str, Any]:
     """Reads and checks a URDF file (meshes hulled, through the cache; inertias repaired with
-    `balance_inertia`) and returns what it holds: `{name, joints, links, collision, visual,
+    `balance_inertia`, off by default) and returns what it holds: `{name, joints, links, collision, visual,
     total_mass, warnings}` (warnings: what was repaired, one sentence each); each joint a dict `{name, type,
     lower, upper, effort, velocity, damping, friction, mimic}` (mimic: `{leader, multiplier,
     offset}` or None), actuated joints first in URDF order, then the mimic ones. Each shape a

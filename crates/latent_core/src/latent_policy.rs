@@ -30,19 +30,40 @@ pub struct LatentPolicy {
 }
 
 impl LatentPolicy {
-    /// The learner of `config` over `[low, high]` with `weights` (w₀ everywhere if none).
-    pub fn new(config: &LearnerConfig, low: &[f64], high: &[f64], weights: Option<&[f64]>) -> Result<Self> {
+    /// The learner of `config` over `[low, high]` with `weights`, acting with `decoder` and
+    /// `encoder` (checked to connect it to a robot).
+    pub fn new(
+        config: &LearnerConfig,
+        low: &[f64],
+        high: &[f64],
+        weights: &[f64],
+        decoder: &GpMap,
+        encoder: &dyn Encode,
+    ) -> Result<Self> {
+        let policy = Self::without_maps(config, low, high, Some(weights))?;
+        let space = StateSpace::Latent { decoder, encoder };
+        policy.learner.check_space(&space, decoder.output_dim())?;
+        Ok(policy)
+    }
+
+    /// `V(z)` ([`LatentPolicy::values`]) at `points` of the learner of `config` over
+    /// `[low, high]` with `weights` (w₀ everywhere if none), no maps needed.
+    pub fn learner_values(
+        config: &LearnerConfig,
+        low: &[f64],
+        high: &[f64],
+        weights: Option<&[f64]>,
+        points: &DMatrix<f64>,
+    ) -> Result<Vec<f64>> {
+        Self::without_maps(config, low, high, weights)?.values(points)
+    }
+
+    fn without_maps(config: &LearnerConfig, low: &[f64], high: &[f64], weights: Option<&[f64]>) -> Result<Self> {
         let mut learner = Learner::new(config, Default::default(), low, high)?;
         if let Some(w) = weights {
             learner.set_weights(w)?;
         }
         Ok(Self { learner })
-    }
-
-    /// Checks that `decoder` and `encoder` connect this policy to a robot.
-    pub fn check_maps(&self, decoder: &GpMap, encoder: &dyn Encode) -> Result<()> {
-        let space = StateSpace::Latent { decoder, encoder };
-        self.learner.check_space(&space, decoder.output_dim())
     }
 
     /// The next servo target for the reached `posture` (D,): encode it, take the greedy latent

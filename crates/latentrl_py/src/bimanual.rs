@@ -50,10 +50,7 @@ pub fn run_bimanual_trials<'py>(
             BimanualTrials::new(plant, config, BimanualLearner::new(latent.as_ref()), options).map_err(to_py)?;
         let total = trials.options.total_episodes();
         let results = run_with_polling(py, total, progress.as_ref(), |c, d| trials.run(c, d).map_err(to_py))?;
-        let out = named_arrays(py, trials.arrays(&results))?;
-        out.set_item("plant", config_to(py, &trials.plant)?)?;
-        out.set_item("learner", config_to(py, &trials.config)?)?;
-        Ok(out)
+        named_arrays(py, trials.arrays(&results))
     })
 }
 

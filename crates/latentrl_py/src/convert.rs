@@ -50,6 +50,12 @@ pub fn to_points<'py>(py: Python<'py>, matrix: DMatrix<f64>) -> PyResult<Bound<'
     PyArray1::from_vec(py, matrix.data.into()).reshape([n, q])
 }
 
+/// Rows of `width` values, one after the other → `(N, width)` array, without copying the buffer.
+pub fn to_rows(py: Python<'_>, width: usize, values: Vec<f64>) -> PyResult<Bound<'_, PyArray2<f64>>> {
+    let n = values.len() / width;
+    PyArray1::from_vec(py, values).reshape([n, width])
+}
+
 /// Vector → 1-D array, without copying the buffer.
 pub fn to_vector<'py>(py: Python<'py>, vector: DVector<f64>) -> Bound<'py, PyArray1<f64>> {
     PyArray1::from_vec(py, vector.data.into())

@@ -61,7 +61,7 @@ pub fn arms_ik<'py>(py: Python<'py>, hands: PyReadonlyArray2<'py, f64>) -> PyRes
 
 /// Grip error `(N,)` in metres of hands `(N, 4)` by `test` ("distance" or "vector").
 #[pyfunction]
-#[pyo3(signature = (hands, test = "distance"))]
+#[pyo3(signature = (hands, test = GripTest::DEFAULT.name()))]
 pub fn grip_error<'py>(
     py: Python<'py>,
     hands: PyReadonlyArray2<'py, f64>,

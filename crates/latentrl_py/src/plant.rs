@@ -3,13 +3,13 @@
 use std::sync::Arc;
 
 use ::sim::task::TaskPlant;
+use ::sim::world::{POSE_WIDTH, POSITION_WIDTH};
 use latent_core::trials::seeded_start;
 use latent_core::{EndReason, Plant};
-use nalgebra::DMatrix;
 use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use crate::convert::{points, rows, to_points};
+use crate::convert::{points, rows, to_points, to_rows};
 use crate::errors::{guard, sim_to_py};
 use crate::task::PyTask;
 
@@ -88,8 +88,7 @@ impl PyTaskPlant {
     }
 
     fn target_position<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let e = self.inner.effectors().len() / 3;
-        to_points(py, DMatrix::from_vec(3, e, self.inner.target_position()))
+        to_rows(py, POSITION_WIDTH, self.inner.target_position())
     }
 
     fn joint_positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
@@ -105,8 +104,7 @@ impl PyTaskPlant {
     }
 
     fn link_poses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let rows = self.inner.world().link_pose_rows();
-        to_points(py, DMatrix::from_vec(7, rows.len() / 7, rows))
+        to_rows(py, POSE_WIDTH, self.inner.world().link_pose_rows())
     }
 
     fn constraint_errors<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
@@ -124,10 +122,13 @@ impl PyTaskPlant {
         joints: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         guard(|| {
-            let base = crate::convert::fixed::<7>("base", &base)?;
+            let base = crate::convert::fixed::<POSE_WIDTH>("base", &base)?;
             let joints = joints.as_array().to_vec();
-            self.inner.place_row(&joints, &base).map_err(sim_to_py)?;
-            self.link_poses(py)
+            to_rows(
+                py,
+                POSE_WIDTH,
+                self.inner.pose_links(&joints, &base).map_err(sim_to_py)?,
+            )
         })
     }
 

@@ -23,9 +23,10 @@ pub fn learner_values<'py>(
     guard(|| {
         let config: LearnerConfig = config_from("learner", learner)?;
         let weights = weights.map(|w| w.as_array().to_vec());
-        let policy = LatentPolicy::new(&config, &low, &high, weights.as_deref()).map_err(to_py)?;
         let z = crate::convert::points("points", &points)?;
-        let values = py.detach(|| policy.values(&z)).map_err(to_py)?;
+        let values = py
+            .detach(|| LatentPolicy::learner_values(&config, &low, &high, weights.as_deref(), &z))
+            .map_err(to_py)?;
         Ok(PyArray1::from_vec(py, values))
     })
 }
@@ -53,8 +54,8 @@ impl PyLatentPolicy {
             let encoder = EncoderObject::extract("encoder", encoder)?;
             let config: LearnerConfig = config_from("learner", learner)?;
             let weights = weights.as_array().to_vec();
-            let policy = LatentPolicy::new(&config, &low, &high, Some(&weights)).map_err(to_py)?;
-            policy.check_maps(&decoder.get().inner, encoder.get()).map_err(to_py)?;
+            let policy = LatentPolicy::new(&config, &low, &high, &weights, &decoder.get().inner, encoder.get())
+                .map_err(to_py)?;
             #[rustfmt::skip]
             return Ok(Self { policy, decoder: decoder.unbind(), encoder });
         })

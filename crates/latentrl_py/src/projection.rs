@@ -22,7 +22,7 @@ pub struct PyProjection {
 #[pymethods]
 impl PyProjection {
     #[new]
-    #[pyo3(signature = (decoder, postures, *, max_iter = DEFAULT.max_iter, margin = DEFAULT.margin, tracking = false))]
+    #[pyo3(signature = (decoder, postures, *, max_iter = DEFAULT.max_iter, margin = DEFAULT.margin, tracking = DEFAULT.tracking))]
     fn new(
         py: Python<'_>,
         decoder: &Bound<'_, PyGpMap>,

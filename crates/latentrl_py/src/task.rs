@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use ::sim::task::survey::{DEFAULT_MAX_POINTS, LearnerGrid, survey};
+use ::sim::task::survey::{DEFAULT_MAX_POINTS, TaskSurvey};
 use ::sim::task::{Task, TaskConfig, TaskTrials};
 use ::sim::urdf::ShapeSummary;
 use numpy::{PyArray1, PyReadonlyArray1, PyReadonlyArray2};
@@ -33,7 +33,7 @@ impl PyTask {
     }
 
     #[staticmethod]
-    #[pyo3(signature = (config, base_dir = PathBuf::from("."), origin = "<dict>"))]
+    #[pyo3(signature = (config, base_dir = PathBuf::from(Task::CONFIG_BASE_DIR), origin = Task::CONFIG_ORIGIN))]
     fn from_dict(py: Python<'_>, config: &Bound<'_, PyAny>, base_dir: PathBuf, origin: &str) -> PyResult<Self> {
         guard(|| {
             let config: TaskConfig = config_from(origin, config)?;
@@ -156,9 +156,7 @@ pub fn run_task_trials<'py>(
             TaskTrials::new(task, demos.as_deref(), &latent, weights.as_deref(), options).map_err(sim_to_py)?;
         let total = trials.options.total_episodes();
         let results = run_with_polling(py, total, progress.as_ref(), |c, d| trials.run(c, d).map_err(sim_to_py))?;
-        let out = named_arrays(py, trials.arrays(&results))?;
-        out.set_item("task", config_to(py, trials.task().config())?)?;
-        Ok(out)
+        named_arrays(py, trials.arrays(&results))
     })
 }
 
@@ -178,13 +176,12 @@ pub fn latent_survey<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
-        let args = latent_args(Some(&decoder), None, Some(latent_low), Some(latent_high))?;
-        let (decoder, low, high) = args.check_box("").map_err(to_py)?;
+        let latent = latent_args(Some(&decoder), None, Some(latent_low), Some(latent_high))?;
         let demos = rows("demos", demos)?;
         let task = Arc::clone(&task.inner);
-        let at = LearnerGrid::for_survey(&task, demos.as_deref(), &low, &high, max_points).map_err(sim_to_py)?;
-        let s = run_with_polling(py, at.grid.len(), progress.as_ref(), |cancel, done| {
-            survey(&task, demos.as_deref(), decoder, &at, physics, cancel, done).map_err(sim_to_py)
+        let survey = TaskSurvey::new(task, demos.as_deref(), latent, max_points, physics).map_err(sim_to_py)?;
+        let s = run_with_polling(py, survey.points(), progress.as_ref(), |cancel, done| {
+            survey.run(cancel, done).map_err(sim_to_py)
         })?;
         let out = named_arrays(py, s.arrays())?;
         out.update(config_to(py, &s.summary())?.cast()?)?;

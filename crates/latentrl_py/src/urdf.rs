@@ -13,15 +13,14 @@ use crate::errors::{guard, sim_to_py};
 
 /// What a checked URDF file holds (`sim::urdf::UrdfSummary`), as a dict.
 #[pyfunction]
-#[pyo3(signature = (path, *, balance_inertia = false))]
+#[pyo3(signature = (path, *, balance_inertia = LoadOptions::default().balance_inertia))]
 pub fn urdf_info<'py>(py: Python<'py>, path: PathBuf, balance_inertia: bool) -> PyResult<Bound<'py, PyAny>> {
     guard(|| {
         let options = LoadOptions { balance_inertia };
-        let cache = ::sim::urdf::cache::default_folder();
-        let model = py
-            .detach(|| UrdfModel::from_file_with_options(&path, cache.as_deref(), options))
+        let summary = py
+            .detach(|| UrdfModel::summary_of_file(&path, options))
             .map_err(sim_to_py)?;
-        config_to(py, &model.summary())
+        config_to(py, &summary)
     })
 }
 
@@ -35,8 +34,7 @@ pub fn demo_columns(
 ) -> PyResult<Vec<usize>> {
     guard(|| {
         let rows: Vec<Vec<f64>> = postures.as_array().rows().into_iter().map(|r| r.to_vec()).collect();
-        let names: Vec<&str> = names.iter().map(String::as_str).collect();
-        py.detach(|| UrdfModel::from_file(&path).and_then(|m| m.demo_columns(&names, &rows)))
+        py.detach(|| UrdfModel::demo_columns_of_file(&path, &names, &rows))
             .map_err(sim_to_py)
     })
 }

@@ -4,8 +4,9 @@
 use std::path::PathBuf;
 
 use ::sim::fall::reset_on_floor;
+use ::sim::task::ObstacleConfig;
 use ::sim::urdf::LoadOptions;
-use ::sim::{FallCriteria, Obstacle, RootMode, UrdfModel, World, WorldConfig};
+use ::sim::{FallCriteria, Obstacle, RootMode, World, WorldConfig};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 
@@ -21,7 +22,8 @@ pub struct PySim {
 #[pymethods]
 impl PySim {
     #[new]
-    #[pyo3(signature = (urdf, *, root = "fixed", floor = None, physics = None, servo = None, balance_inertia = false))]
+    #[pyo3(signature = (urdf, *, root = RootMode::default().as_str(), floor = None, physics = None, servo = None,
+                        balance_inertia = LoadOptions::default().balance_inertia))]
     fn new(
         py: Python<'_>,
         urdf: &Bound<'_, PyAny>,
@@ -40,11 +42,8 @@ impl PySim {
                 .extract()
                 .map_err(|_| InvalidInputError::new_err("urdf: expected a path or the URDF XML as a str"))?;
             let options = LoadOptions { balance_inertia };
-            let model = py
-                .detach(|| UrdfModel::from_xml_or_file(&path, options))
-                .map_err(sim_to_py)?;
-            let inner = py.detach(|| World::new(model, config)).map_err(sim_to_py)?;
-            Ok(Self { inner })
+            let inner = py.detach(|| World::from_urdf(&path, options, config));
+            inner.map(|inner| Self { inner }).map_err(sim_to_py)
         })
     }
 
@@ -109,10 +108,7 @@ impl PySim {
             let wrong = |n| InvalidInputError::new_err(format!("n: expected an int >= 0 or None, got {n}"));
             let n = n.map(|n| usize::try_from(n).map_err(|_| wrong(n))).transpose()?;
             let inner = &mut self.inner;
-            py.detach(|| match n {
-                Some(n) => inner.step(n),
-                None => inner.step_rl(),
-            });
+            py.detach(|| inner.advance(n));
             Ok(())
         })
     }
@@ -127,25 +123,28 @@ impl PySim {
 
     fn frame_position<'py>(&self, py: Python<'py>, link: &str) -> PyResult<Bound<'py, PyArray1<f64>>> {
         guard(|| {
-            let frame = self.inner.frame(link, [0.0; 3]).map_err(sim_to_py)?;
-            Ok(PyArray1::from_vec(py, self.inner.frame_position(&frame).to_vec()))
+            Ok(PyArray1::from_vec(
+                py,
+                self.inner.link_position(link).map_err(sim_to_py)?.into(),
+            ))
         })
     }
 
-    #[pyo3(signature = (center, half_extents, *, sensor = true, name = "box"))]
+    #[pyo3(signature = (center, half_extents, *, sensor = ObstacleConfig::default().sensor,
+                        name = ObstacleConfig::default().name))]
     fn add_box_obstacle(
         &mut self,
         center: PyReadonlyArray1<'_, f64>,
         half_extents: PyReadonlyArray1<'_, f64>,
         sensor: bool,
-        name: &str,
+        name: String,
     ) -> PyResult<usize> {
         guard(|| {
             let (center, half_extents) = (
                 fixed::<3>("center", &center)?,
                 fixed::<3>("half_extents", &half_extents)?,
             );
-            let obstacle = Obstacle::aligned_box(name, center, half_extents, sensor);
+            let obstacle = Obstacle::aligned_box(&name, center, half_extents, sensor);
             self.inner.add_obstacle(obstacle).map_err(sim_to_py)
         })
     }

@@ -210,6 +210,19 @@ pub enum GripTest {
     Vector,
 }
 
+impl GripTest {
+    /// The test measured when none is named: the paper's distance test.
+    pub const DEFAULT: Self = Self::Distance;
+
+    /// The test's name, as [`GripTest::from_str`](std::str::FromStr) reads it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Distance => "distance",
+            Self::Vector => "vector",
+        }
+    }
+}
+
 impl std::str::FromStr for GripTest {
     type Err = SimError;
 

@@ -66,8 +66,15 @@ impl Task {
         Self::from_config(config, path.parent().unwrap_or(Path::new(".")), &origin)
     }
 
+    /// The folder a configuration's URDF path is resolved against when none is named.
+    pub const CONFIG_BASE_DIR: &'static str = ".";
+
+    /// What names a task made from a configuration in errors when nothing else does.
+    pub const CONFIG_ORIGIN: &'static str = "<dict>";
+
     /// A task from a configuration (e.g. a Python dict); its URDF path is resolved against
-    /// `base_dir`, `origin` names it in errors.
+    /// `base_dir` ([`Task::CONFIG_BASE_DIR`] by default), `origin` names it in errors
+    /// ([`Task::CONFIG_ORIGIN`] by default).
     pub fn from_config(config: TaskConfig, base_dir: &Path, origin: &str) -> Result<Self> {
         let failed = |reason: String| SimError::Task {
             origin: origin.to_string(),

@@ -468,6 +468,12 @@ impl UrdfModel {
         Ok(order)
     }
 
+    /// [`UrdfModel::demo_columns`] of the robot in the URDF file at `path`.
+    pub fn demo_columns_of_file(path: &Path, names: &[String], rows: &[Vec<f64>]) -> Result<Vec<usize>> {
+        let names: Vec<&str> = names.iter().map(String::as_str).collect();
+        Self::from_file(path)?.demo_columns(&names, rows)
+    }
+
     /// Names of the joints with a servo: the actuated ones, then the mimic ones.
     pub fn servoed_names(&self) -> Vec<&str> {
         let mimics = self.mimics.iter().map(|m| m.joint.name.as_str());

@@ -17,14 +17,14 @@ use crate::error::{Result, SimError, check_finite};
 use crate::pd::{PdGains, drive, retarget};
 use crate::pose::to_pose;
 use crate::shapes::Obstacle;
-use crate::urdf::{JointSlot, RootMode, UrdfModel};
+use crate::urdf::{JointSlot, LoadOptions, RootMode, UrdfModel};
 
 mod config;
 mod filter;
 mod readout;
 mod snapshot;
 pub use config::{JointServo, PhysicsConfig, ServoConfig, WorldConfig};
-pub use readout::Frame;
+pub use readout::{Frame, POSE_WIDTH, POSITION_WIDTH};
 pub use snapshot::WorldSnapshot;
 
 /// An obstacle in the world and its collider.
@@ -62,6 +62,12 @@ impl std::fmt::Display for World {
 }
 
 impl World {
+    /// The world of the robot in `source` (URDF XML or a file's path,
+    /// [`UrdfModel::from_xml_or_file`]) loaded with `options`: [`World::new`].
+    pub fn from_urdf(source: &std::path::Path, options: LoadOptions, config: WorldConfig) -> Result<Self> {
+        Self::new(UrdfModel::from_xml_or_file(source, options)?, config)
+    }
+
     /// Builds the world: every joint at zero (clamped into its limits), servos holding
     /// that posture, optional floor. Fails on a configuration value that breaks its rule or a
     /// per-joint servo naming no actuated joint.
@@ -346,5 +352,10 @@ impl World {
     /// Advances the world by one RL step (`substeps` physics steps).
     pub fn step_rl(&mut self) {
         self.step(self.config.physics.substeps);
+    }
+
+    /// Advances the world by `n` physics steps, or by one RL step ([`World::step_rl`]) if none.
+    pub fn advance(&mut self, n: Option<usize>) {
+        self.step(n.unwrap_or(self.config.physics.substeps));
     }
 }

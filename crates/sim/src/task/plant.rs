@@ -30,7 +30,7 @@ use crate::error::{Result, SimError};
 use crate::fall::{FallCriteria, GROUND_CLEARANCE, reset_on_ground, support_margin};
 use crate::shapes::{Obstacle, ObstacleShape};
 use crate::urdf::RootMode;
-use crate::world::{Frame, World, WorldSnapshot};
+use crate::world::{Frame, POSE_WIDTH, POSITION_WIDTH, World, WorldSnapshot};
 
 /// A resolved constraint: the frames it reads and its test.
 #[derive(Debug, Clone)]
@@ -274,13 +274,13 @@ impl TaskPlant {
             .sum()
     }
 
-    /// The target h* in the world now, (x, y, z) per effector: `target.position`, moved with
+    /// The target h* in the world now, one row of [`POSITION_WIDTH`] per effector: `target.position`, moved with
     /// `target.relative_to`'s origin if set (what figures and videos draw).
     pub fn target_position(&self) -> Vec<f64> {
         let origin = self.target_origin_position();
         self.target
-            .chunks_exact(3)
-            .flat_map(|t| (0..3).map(move |k| t[k] + origin[k]))
+            .chunks_exact(POSITION_WIDTH)
+            .flat_map(|t| (0..POSITION_WIDTH).map(move |k| t[k] + origin[k]))
             .collect()
     }
 
@@ -411,13 +411,14 @@ impl TaskPlant {
         Ok([c.x, c.y, c.z])
     }
 
-    /// [`TaskPlant::place`] with the base pose as a recorded row's 7 values (position,
-    /// quaternion x, y, z, w).
-    pub fn place_row(&mut self, posture: &[f64], base: &[f64; 7]) -> Result<()> {
+    /// [`TaskPlant::place`] with the base pose as a recorded row's [`POSE_WIDTH`] values
+    /// (position, quaternion x, y, z, w): the link poses there ([`World::link_pose_rows`]).
+    pub fn pose_links(&mut self, posture: &[f64], base: &[f64; POSE_WIDTH]) -> Result<Vec<f64>> {
         let b = base;
         let rotation = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(b[6], b[3], b[4], b[5]));
         let pose = nalgebra::Isometry3::from_parts(nalgebra::Translation3::new(b[0], b[1], b[2]), rotation);
-        self.place(posture, &pose)
+        self.place(posture, &pose)?;
+        Ok(self.world.link_pose_rows())
     }
 
     /// Teleports the robot to `posture` with its base at `base` (a floating root; ignored for a

@@ -24,6 +24,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use latent_core::gp::GpMap;
+use latent_core::trials::LatentArgs;
 use latent_core::{Learner, Plant, ResultArray};
 use rayon::prelude::*;
 
@@ -276,7 +277,7 @@ pub struct Closest {
     pub effectors: Vec<f64>,
 }
 
-/// The grid of a [`survey`] and the learner's moves on it.
+/// The grid of a [`TaskSurvey`] and the learner's moves on it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LearnerGrid {
     /// The grid, at the learner's step (or `stride` of them).
@@ -286,18 +287,6 @@ pub struct LearnerGrid {
 }
 
 impl LearnerGrid {
-    /// [`LearnerGrid::new`] once a plant of `task` with `demos` builds: what a survey runs on.
-    pub fn for_survey(
-        task: &Arc<Task>,
-        demos: Option<&[Vec<f64>]>,
-        low: &[f64],
-        high: &[f64],
-        max_points: usize,
-    ) -> Result<Self> {
-        TaskPlant::new(Arc::clone(task), demos)?;
-        Self::new(task, low, high, max_points)
-    }
-
     /// The grid over `[low, high]` at `task`'s learner step with at most `max_points` points.
     pub fn new(task: &Task, low: &[f64], high: &[f64], max_points: usize) -> Result<Self> {
         let learner = Learner::new(&task.config().learner, task.episode_rules(), low, high)
@@ -324,10 +313,58 @@ impl LearnerGrid {
     }
 }
 
+/// A survey of a task's latent space ready to run: what `latentrl check` asks for, in one
+/// object so that a caller can learn its size (for progress) before running it.
+pub struct TaskSurvey<'a> {
+    task: Arc<Task>,
+    demos: Option<&'a [Vec<f64>]>,
+    decoder: &'a GpMap,
+    at: LearnerGrid,
+    physics: bool,
+}
+
+impl<'a> TaskSurvey<'a> {
+    /// The survey of `task`'s latent space given by `latent` (its decoder and box, checked by
+    /// [`LatentArgs::check_box`]) on a grid of at most `max_points` points at the learner's
+    /// step, each move also through the physics with `physics`; `demos` as for
+    /// [`TaskPlant::new`] (a plant of them must build).
+    pub fn new(
+        task: Arc<Task>,
+        demos: Option<&'a [Vec<f64>]>,
+        latent: LatentArgs<'a>,
+        max_points: usize,
+        physics: bool,
+    ) -> Result<Self> {
+        let (decoder, low, high) = latent.check_box("")?;
+        TaskPlant::new(Arc::clone(&task), demos)?;
+        let at = LearnerGrid::new(&task, &low, &high, max_points)?;
+        #[rustfmt::skip]
+        return Ok(Self { task, demos, decoder, at, physics });
+    }
+
+    /// The points the survey classifies (what `done` counts to).
+    pub fn points(&self) -> usize {
+        self.at.grid.len()
+    }
+
+    /// Runs the survey: points are classified in parallel, `done` counts them and `cancel`
+    /// stops the survey (an error).
+    pub fn run(&self, cancel: &AtomicBool, done: &AtomicUsize) -> Result<Survey> {
+        survey(
+            &self.task,
+            self.demos,
+            self.decoder,
+            &self.at,
+            self.physics,
+            cancel,
+            done,
+        )
+    }
+}
+
 /// Surveys `task`'s latent space of `decoder` on `at` (its grid and the learner's moves), each
-/// move also through the physics with `physics`; `demos` as for [`TaskPlant::new`]. Points are
-/// classified in parallel, `done` counts them and `cancel` stops the survey (an error).
-pub fn survey(
+/// move also through the physics with `physics` ([`TaskSurvey::run`]).
+fn survey(
     task: &Arc<Task>,
     demos: Option<&[Vec<f64>]>,
     decoder: &GpMap,

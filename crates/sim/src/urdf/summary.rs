@@ -101,6 +101,13 @@ impl ShapeSummary {
 }
 
 impl UrdfModel {
+    /// What the URDF file at `path` holds, read with the default hull cache and the repairs of
+    /// `options` ([`UrdfModel::summary`]).
+    pub fn summary_of_file(path: &std::path::Path, options: super::LoadOptions) -> crate::error::Result<UrdfSummary> {
+        let cache = super::cache::default_folder();
+        Ok(Self::from_file_with_options(path, cache.as_deref(), options)?.summary())
+    }
+
     /// What this robot holds as plain data.
     pub fn summary(&self) -> UrdfSummary {
         let links = self.link_names();

@@ -9,6 +9,13 @@ use crate::error::{Result, SimError};
 use crate::pose::to_isometry;
 use crate::urdf::JointSlot;
 
+/// Values per position row: x, y, z (m).
+pub const POSITION_WIDTH: usize = 3;
+
+/// Values per pose row ([`World::link_pose_rows`]): position x, y, z (m) and quaternion x, y,
+/// z, w.
+pub const POSE_WIDTH: usize = 7;
+
 /// A point fixed on a link: where to read a hand position. Made by [`World::frame`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frame {
@@ -88,6 +95,11 @@ impl World {
         Ok(self.frame_pose(&self.frame(link, [0.0; 3])?))
     }
 
+    /// World position of link `link`'s origin (its URDF link frame).
+    pub fn link_position(&self, link: &str) -> Result<[f64; 3]> {
+        Ok(self.frame_position(&self.frame(link, [0.0; 3])?))
+    }
+
     /// World poses of every URDF link, in URDF link order (`None` for a link neither with a
     /// body nor fixed to one).
     pub fn link_poses(&self) -> Vec<Option<Isometry3<f64>>> {
@@ -104,18 +116,18 @@ impl World {
             .collect()
     }
 
-    /// [`World::link_poses`] as rows of 7 values (position, quaternion x, y, z, w), NaN for a
-    /// link without a pose.
+    /// [`World::link_poses`] as rows of [`POSE_WIDTH`] values (position, quaternion x, y, z,
+    /// w), NaN for a link without a pose.
     pub fn link_pose_rows(&self) -> Vec<f64> {
         let poses = self.link_poses();
-        let mut out = Vec::with_capacity(7 * poses.len());
+        let mut out = Vec::with_capacity(POSE_WIDTH * poses.len());
         for pose in &poses {
             match pose {
                 Some(p) => {
                     out.extend(p.translation.vector.iter());
                     out.extend(p.rotation.coords.iter());
                 }
-                None => out.extend([f64::NAN; 7]),
+                None => out.extend([f64::NAN; POSE_WIDTH]),
             }
         }
         out
