@@ -82,7 +82,7 @@ from latentrl import LatentrlError
 from latentrl.datasets import arm_postures
 from latentrl.demos import load_demos
 from latentrl.envs import shipped_demos
-from latentrl.experiments.results import write_json
+from latentrl.results import write_json
 from latentrl.robot_info import urdf_info
 from latentrl.task import Task
 

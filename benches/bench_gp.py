@@ -53,7 +53,7 @@ from latentrl.back_constraint import start_weights
 from latentrl._reference import gplvm_nll_grad as numpy_nll_grad
 from latentrl._reference import se_kernel
 from latentrl.datasets import arm_postures
-from latentrl.experiments.results import write_json
+from latentrl.results import write_json
 from latentrl.pca import PCA
 
 try:

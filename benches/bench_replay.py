@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from latentrl.saved_runs import saved_run
-from latentrl.experiments.results import RunFolder
+from latentrl.experiments.run_folder import RunFolder
 from latentrl.replay import episode_path, recorded, render_frames
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -30,7 +30,7 @@ import numpy as np
 from bench_sim import RapierRobot
 from latentrl import Task
 from latentrl.envs import shipped_demos
-from latentrl.experiments.results import environment, write_json
+from latentrl.results import environment, write_json
 
 ROUNDS, EPISODES, STEPS = 8, 8, 120
 

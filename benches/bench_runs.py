@@ -21,7 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from latentrl.experiments.results import environment, read_json, write_json
+from latentrl.results import environment, read_json, write_json
 from latentrl.machine import worker_threads
 
 

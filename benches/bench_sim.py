@@ -61,7 +61,7 @@ import latentrl
 from latentrl._native import Sim
 from latentrl.datasets import arm_postures
 from latentrl.task import Task
-from latentrl.experiments.results import write_json
+from latentrl.results import write_json
 
 try:
     import mujoco

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from latentrl.experiments.ray_backend import RayBackend
-from latentrl.experiments.results import environment, write_json
+from latentrl.results import environment, write_json
 from latentrl.machine import worker_threads
 from latentrl.experiments.sweep import Sweep, run_sweep
 

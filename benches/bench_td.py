@@ -28,7 +28,7 @@ from latentrl._reference import rbf_centres, rbf_features, td0_update  # noqa: E
 from latentrl.datasets import bimanual_pairs  # noqa: E402
 from latentrl.experiments.exp1 import Exp1Preset, configs  # noqa: E402
 from latentrl.run_settings import latent_box  # noqa: E402
-from latentrl.experiments.results import environment, write_json  # noqa: E402
+from latentrl.results import environment, write_json  # noqa: E402
 
 
 def numpy_loop(model: GPLVM, preset: Exp1Preset, low, high, steps: int, seed: int) -> float:

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from latentrl.experiments.results import RunFolder
+from latentrl.experiments.run_folder import RunFolder
 from latentrl.experiments.sweep import episodes_to_threshold
 from latentrl.task import end_reasons
 

@@ -27,7 +27,8 @@ import atheris
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 with atheris.instrument_imports():
-    import latentrl.experiments.results  # noqa: F401
+    import latentrl.experiments.run_folder  # noqa: F401
+    import latentrl.results  # noqa: F401
     import latentrl.replay  # noqa: F401
     import latentrl.train  # noqa: F401
 

@@ -69,7 +69,7 @@ def read_file(root: Path, name: str, *, draw: bool = False) -> None:
     drawing (the latent path, the links' poses: ~0.5 s an episode, in the GP encoder)."""
     from latentrl.saved_runs import saved_run
     from latentrl.experiments.presets import describe
-    from latentrl.experiments.results import RunFolder
+    from latentrl.experiments.run_folder import RunFolder
     from latentrl.experiments.training import setup
     from latentrl.replay import replay, rollout_episode
     from latentrl.train import LatentPolicy

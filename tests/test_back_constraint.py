@@ -82,7 +82,7 @@ def test_refusals_name_the_setting(X, model):
 
 def test_the_experiments_take_the_encoder_as_a_checked_preset_field(model):
     from latentrl.experiments.exp2 import Exp2Preset
-    from latentrl.experiments.results import gplvm_info
+    from latentrl.results import gplvm_info
 
     assert Exp2Preset().encoder == "gp"
     with pytest.raises(ValueError, match="run: encoder: unknown variant `pca`, expected one of `gp`, `projection`, `back_constrained`, `tracking`"):

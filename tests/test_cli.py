@@ -326,7 +326,8 @@ def test_plot_redraws_the_finished_trials_of_a_partial_run(tmp_path):
     from latentrl.experiments.exp1 import Exp1Preset
     from latentrl.experiments import run_experiment
     from latentrl.run_settings import with_overrides
-    from latentrl.experiments.results import RunFolder, finished_trials, write_npz
+    from latentrl.results import finished_trials, write_npz
+    from latentrl.experiments.run_folder import RunFolder
 
     run_experiment("exp1", with_overrides(Exp1Preset.quick(), {"trials": 2, "episodes": 5, "plant.max_steps": 20}),
              tmp_path / "run", progress=False)

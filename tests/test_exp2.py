@@ -16,7 +16,7 @@ from latentrl.experiments import exp2
 from latentrl.experiments.exp2 import Exp2Preset
 from latentrl.experiments import run_experiment
 from latentrl.run_settings import with_overrides
-from latentrl.experiments.results import write_npz
+from latentrl.results import write_npz
 from learning import assert_separated
 
 EXPERIMENT = "exp2"

@@ -219,7 +219,7 @@ def test_a_stopped_trial_is_summarised_over_the_episodes_it_ran():
     """results.json's per-trial summary of a trial the stopping rule ended after 400 of 1000
     episodes: its last tenth is of the 400 (the zoo's iiwa-style arm had `mean_return_last` NaN
     and `reached_last` 0 from the budget's unset tail)."""
-    from latentrl.experiments.results import summarise_trial
+    from latentrl.results import summarise_trial
 
     budget, ran = 1000, 400
     ends = np.full((1, budget), -1, dtype=np.int8)
@@ -240,7 +240,7 @@ def test_a_run_reads_back_under_a_version_with_a_new_model_parameter(runs, monke
     version would write them: a parameter added since (here `future`, None) is not a changed
     model (the sparse GPLVM's `inducing` made every earlier train run "changed since the run")."""
     from latentrl import GPLVM
-    from latentrl.experiments.results import read_results
+    from latentrl.results import read_results
     from latentrl.experiments.training import TrainRun, prepared
 
     out = runs["learner"]

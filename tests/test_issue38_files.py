@@ -19,7 +19,7 @@ from latentrl import GPLVM, _native
 from latentrl._persistence import read_npz
 from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, open_regular, read_bounded, read_text
 from latentrl._native import InvalidInputError, Sim
-from latentrl.experiments.results import read_json
+from latentrl.results import read_json
 from latentrl.experiments.sweep import load_sweep
 from latentrl.task import Task
 
@@ -120,7 +120,7 @@ def test_a_file_over_its_cap_is_refused_naming_the_cap(tmp_path: Path, monkeypat
         GPLVM.load(model)
     results = tmp_path / "results.json"
     results.write_text(json.dumps({"x": 1}))
-    monkeypatch.setattr("latentrl.experiments.results.MAX_JSON_BYTES", 4)
+    monkeypatch.setattr("latentrl.results.MAX_JSON_BYTES", 4)
     with pytest.raises(ValueError, match="results.json: is 8 bytes, more than the 4 bytes"):
         read_json(results)
 

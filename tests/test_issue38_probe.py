@@ -163,7 +163,7 @@ def test_a_full_disk_names_the_file_and_a_new_run_leaves_no_folder(tmp_path: Pat
         _persistence.atomic_write(tmp_path / "results.json", full)
     assert list(tmp_path.iterdir()) == []  # the temporary file is gone too
 
-    from latentrl.experiments import results
+    from latentrl import results
 
     monkeypatch.setattr(results, "atomic_write",
                         lambda path, write: _persistence.atomic_write(path, full if Path(path).name == "results.json" else write))

@@ -14,7 +14,7 @@ import numpy as np
 
 from latentrl.saved_runs import saved_run
 from latentrl.experiments import exp3
-from latentrl.experiments.results import RunFolder
+from latentrl.experiments.run_folder import RunFolder
 from latentrl.task import end_reasons
 
 out = Path(sys.argv[1])

@@ -112,7 +112,7 @@ def _report_of(out: Path, *, write: bool = False, as_json: bool = False) -> None
     """The verdict on the policy in `out` (rollouts from the test starts, the check's advice);
     printed, and with `write` saved as `out/report.json`."""
     from latentrl.check import check_task
-    from latentrl.experiments.results import environment, write_json
+    from latentrl.results import environment, write_json
     from latentrl.train import LatentPolicy
     from latentrl.verdict import training_verdict
 
@@ -179,7 +179,7 @@ def _rollout(args: argparse.Namespace) -> int:
 
 
 def _write_rollout(args: argparse.Namespace, path: Path, policy: Any, results: dict[str, dict[str, Any]]) -> None:
-    from latentrl.experiments.results import environment, write_json, write_npz
+    from latentrl.results import environment, write_json, write_npz
 
     write_npz(args.out / "rollout.npz", {f"{kind}_{k}": r[k] for kind, r in results.items()
                                          for k in ("returns", "ends", "reached", "paths")})
@@ -223,7 +223,7 @@ def _fit(args: argparse.Namespace) -> int:
 
 def _plot(args: argparse.Namespace) -> int:
     from latentrl.experiments import experiments
-    from latentrl.experiments.results import RunFolder
+    from latentrl.experiments.run_folder import RunFolder
 
     name, preset = saved_run(args.results, train=True)
     arrays, done = RunFolder(args.results).finished()
@@ -295,7 +295,7 @@ def _urdf_info(args: argparse.Namespace) -> int:
 
 
 def _info(args: argparse.Namespace) -> int:
-    from latentrl.experiments.results import environment
+    from latentrl.results import environment
 
     text = json.dumps(environment(), indent=2)
     try:

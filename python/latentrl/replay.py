@@ -264,7 +264,7 @@ def check_rollout_meta(path: Path, meta: dict[str, Any]) -> None:
 def rollout_episode(out: Path, policy: str, trial: int, episode: int, view: str | None = None) -> Recorded:
     """Episode `episode` of trial `trial` of the `policy` ("greedy", "softmax", "random") rollout
     that `latentrl rollout` wrote into `out`, with the saved policy it names."""
-    from latentrl.experiments.results import read_json
+    from latentrl.results import read_json
     from latentrl.train import POLICIES, LatentPolicy
 
     meta = read_json(out / "rollout.json")
@@ -305,7 +305,7 @@ def replay(run_dir: Path, experiment: str, preset: Any, out: Path | None = None,
     """Renders one recorded episode of the run in `run_dir` (`experiment` "exp1", "exp2", "exp3"
     or "train", its saved `preset`) to the video `out` and/or the Rerun recording `rerun`;
     returns what was rendered. Every argument is checked before drawing."""
-    from latentrl.experiments.results import RunFolder
+    from latentrl.experiments.run_folder import RunFolder
 
     if experiment not in REPLAYABLE:
         raise ValueError(f"{run_dir}: a run of {experiment}; replay draws runs of {', '.join(REPLAYABLE[:-1])} "

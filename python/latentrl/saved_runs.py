@@ -15,7 +15,7 @@ def saved_run(out_dir: Path, *, train: bool = False) -> tuple[str, Any]:
     also ("train", its TrainRun) for a `latentrl train` directory; ValueError if the directory
     holds none, or the preset does not fit this version."""
     from latentrl.experiments import experiments
-    from latentrl.experiments.results import RunFolder
+    from latentrl.experiments.run_folder import RunFolder
 
     folder = RunFolder(out_dir)
     if not folder.results_path.is_file():

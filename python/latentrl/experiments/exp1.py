@@ -24,7 +24,7 @@ from latentrl import _native
 from latentrl.datasets import bimanual_pairs
 from latentrl.experiments.latent_runs import Fitted, recorded_episodes, run_fit
 from latentrl.run_settings import LatentRun, check_ints
-from latentrl.experiments.results import gplvm_info
+from latentrl.results import gplvm_info
 from latentrl.experiments.runner import RunTrials, Setup
 
 

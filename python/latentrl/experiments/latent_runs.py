@@ -16,7 +16,8 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl.run_settings import latent_box
-from latentrl.experiments.results import RunFolder, gplvm_info
+from latentrl.results import gplvm_info
+from latentrl.experiments.run_folder import RunFolder
 from latentrl.experiments.runner import RunTrials, Setup
 from latentrl.gplvm import GPLVM
 from latentrl.task import Task

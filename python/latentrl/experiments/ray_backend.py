@@ -28,7 +28,8 @@ import numpy as np
 from latentrl.machine import worker_threads
 from latentrl.experiments import rl_experiments
 from latentrl.experiments.presets import check_type
-from latentrl.experiments.results import PER_EPISODE, PER_TRIAL, RunFolder
+from latentrl.results import PER_EPISODE, PER_TRIAL
+from latentrl.experiments.run_folder import RunFolder
 from latentrl.experiments.runner import Job, Setup, run_rl
 
 

@@ -21,11 +21,11 @@ import numpy as np
 from latentrl.machine import peak_rss_mib, worker_threads
 from latentrl.run_lock import run_lock
 from latentrl.experiments.presets import describe
-from latentrl.experiments.results import (
+from latentrl.experiments.run_folder import RunFolder
+from latentrl.results import (
     PER_EPISODE,
     PER_TRIAL,
     PRESET_KEY,
-    RunFolder,
     array_key,
     as_saved,
     environment,

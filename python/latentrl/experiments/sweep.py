@@ -48,7 +48,8 @@ from latentrl.experiments import RlExperiment, rl_experiments, task_schema
 from latentrl.experiments.presets import check_type, describe
 from latentrl.run_settings import with_overrides
 from latentrl.experiments.ray_backend import RayBackend
-from latentrl.experiments.results import RunFolder, environment, read_json, write_json
+from latentrl.results import environment, read_json, write_json
+from latentrl.experiments.run_folder import RunFolder
 from latentrl.machine import worker_threads
 from latentrl.experiments.runner import Job, Setup, run_in_process, run_rl
 from latentrl.progress import progress_bar

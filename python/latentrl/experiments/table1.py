@@ -35,7 +35,7 @@ from latentrl._native import arms_fk
 from latentrl.datasets import arm_postures, bimanual_pairs, grip_error
 from latentrl.experiments.presets import describe
 from latentrl.run_settings import check_floats, check_ints, check_run_fields
-from latentrl.experiments.results import environment, write_json
+from latentrl.results import environment, write_json
 from latentrl.machine import worker_threads
 from latentrl.task import run_default
 

@@ -87,7 +87,7 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
     rule says so (`derive.SPACING`), before a new run saves its model."""
     from latentrl.derive import SPACING, applied, even_twin
     from latentrl.experiments.latent_runs import Fitted, run_fit
-    from latentrl.experiments.results import RunFolder
+    from latentrl.experiments.run_folder import RunFolder
 
     overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
     options = DemoOptions(**{f.name: getattr(run, f.name) for f in dataclasses.fields(DemoOptions)})
@@ -170,7 +170,7 @@ def input_digests(task_file: str, task: Task, demos: np.ndarray, model: Mapping[
 
 def save_policy(run: TrainRun, out: Path) -> LatentPolicy:
     """`out/policy.npz` from the finished trials of the run in `out`."""
-    from latentrl.experiments.results import RunFolder
+    from latentrl.experiments.run_folder import RunFolder
 
     task, demos, model = fitted(run, out)
     arrays, done = RunFolder(out).finished()
