@@ -27,7 +27,9 @@ try:
     from latentrl.task import Task
     from latentrl.train import LatentPolicy
 
-    import latentrl.envs  # noqa: F401  (registers the Gymnasium environments, as ale_py does)
+    from latentrl._gym_registration import register_when_gymnasium_loads
+
+    register_when_gymnasium_loads()  # the Gymnasium environments, as ale_py does
 except BaseException as err:
     # Ctrl-C while the command still imports (its first ~0.3 s): the command's own message and
     # exit code, not the interpreter's traceback (or the native module's "initialization failed").
@@ -43,11 +45,16 @@ if _TYPE_CHECKING:
 
 def __getattr__(name: str) -> _Any:
     """`train_latent_policy`, `latentrl train`'s run in memory, loaded when first asked for: it
-    lives with its experiment, and no public module imports the experiments (ARCHITECTURE.md)."""
+    lives with its experiment, and no public module imports the experiments (ARCHITECTURE.md);
+    `envs`, the Gymnasium environments, loaded (with Gymnasium) when first asked for."""
     if name == "train_latent_policy":
         from latentrl.experiments.training import train_latent_policy
 
         return train_latent_policy
+    if name == "envs":
+        import latentrl.envs
+
+        return latentrl.envs
     raise AttributeError(f"module 'latentrl' has no attribute {name!r}")
 
 

@@ -7,9 +7,7 @@ from __future__ import annotations
 import contextlib
 import os
 import struct
-import tokenize
 import uuid
-import zipfile
 import zlib
 from collections.abc import Callable, Collection, Iterator, Mapping
 from pathlib import Path
@@ -87,6 +85,8 @@ def _check_npz_sizes(fh: IO[bytes]) -> None:
     """Refuses, before anything is unpacked, an archive that would unpack to more than
     MAX_NPZ_BYTES (a zip bomb) or a member whose header declares more data than the member
     holds (an array of 10¹² elements in a small file)."""
+    import zipfile  # loaded by the first read, not by `import latentrl`
+
     with zipfile.ZipFile(fh) as archive:
         members = archive.infolist()
         total = sum(m.file_size for m in members)
@@ -107,6 +107,9 @@ def read_npz(path: PathLike, keys: Collection[str] | None = None) -> dict[str, N
     """Every array of the NPZ file at `path` (those named in `keys` if given), read eagerly
     without pickles; a file that is not a regular file of at most MAX_NPZ_BYTES
     (`latentrl._files`) or not a readable NPZ is a ValueError."""
+    import tokenize  # with zipfile: loaded by the first read, not by `import latentrl`
+    import zipfile
+
     with open_regular(path, MAX_NPZ_BYTES, "an NPZ file") as fh:
         magic = fh.read(6)
         if magic.startswith(b"\x93NUMPY"):

@@ -12,11 +12,9 @@ from here too.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import tomllib
 from collections.abc import Mapping
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -56,6 +54,8 @@ def shipped_path(name: str) -> Path:
     """Path of the shipped task file `name` (one of `SHIPPED`)."""
     if name not in SHIPPED:
         raise ValueError(f"no shipped task {name!r}; shipped tasks: {', '.join(SHIPPED)}")
+    from importlib import resources  # loaded when a shipped task is, not by `latentrl --help`
+
     return Path(str(resources.files("latentrl") / "tasks" / f"{name}.toml"))
 
 
@@ -154,6 +154,8 @@ class Task:
             urdf = read_bounded(self.urdf_path, MAX_URDF_BYTES, "a URDF")
         except ValueError as err:
             raise ValueError(f"{self.urdf_path}: {err}") from None
+        import hashlib  # OpenSSL: loaded by the first digest, not by `import latentrl`
+
         return hashlib.sha256(text.encode() + b"\0" + urdf).hexdigest()
 
     def plant(self, demos: NDArray[np.float64] | None = None) -> _native.TaskPlant:

@@ -1,4 +1,6 @@
-"""Gymnasium environments, registered when `latentrl` is imported (as `import ale_py` does).
+"""Gymnasium environments, registered when `latentrl` is imported (as `import ale_py` does;
+Gymnasium itself loads when first imported, the environments registered then:
+`latentrl._gym_registration`).
 
 - `TaskEnv(task)`: any task (`latentrl.Task`, docs/tasks.md) as an environment over the native
   plant, which applies the task's rules. The registered robot environments are instances:

@@ -7,7 +7,6 @@ The same training from Python, in memory: `train_latent_policy` (`latentrl.train
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 from dataclasses import dataclass
 from functools import lru_cache
@@ -116,6 +115,8 @@ def _derived(task: Task, model: GPLVM, demos: np.ndarray, margin: float,
              even: Callable[[], GPLVM] | None) -> tuple[Derived, ...]:
     """`derive.derive` for `task` on `model` (cached per task, fit, given keys, margin and whether
     the spacing may be derived; a spacing it derives is cached for the evenly spaced fit too)."""
+    import hashlib  # OpenSSL: loaded by a run, not by `train --help`
+
     from latentrl.derive import SPACING, derive
 
     def key(m: GPLVM) -> tuple[Any, ...]:
@@ -153,6 +154,8 @@ def input_digests(task_file: str, task: Task, demos: np.ndarray, model: Mapping[
     postures as the learner gets them (joint order, float64) and the GPLVM's arrays as saved
     (`model`: a run's gplvm.npz as read, so a parameter a later version adds does not change
     it); a resume compares them (`RunFolder.check_inputs`)."""
+    import hashlib  # OpenSSL: loaded by a run, not by `train --help`
+
     def sha(data: bytes) -> str:
         return hashlib.sha256(data).hexdigest()
 
