@@ -266,6 +266,23 @@ def test_timeouts_are_told_apart_by_their_reward_per_step() -> None:
     assert "away from the target (mean reward 0.10 per step)" in far and "smaller learner.step" not in far
 
 
+def test_a_trial_stopped_in_a_dip_below_another_is_told() -> None:
+    """Issue #37: the zoo's snake had trials stopped at 900 episodes far below one that ran on;
+    run to the budget, it reached more. Stopped trials level with the best are not told."""
+    from latentrl.verdict import stop_advice
+
+    reached = np.zeros((3, 100), dtype=bool)
+    reached[0, :100:2] = True  # ran the budget, 50 % in its last tenth
+    reached[1, :40:4] = True  # stopped at 40, 25 % in its last tenth
+    reached[2, :60:2] = True  # stopped at 60, level with the best
+    runs = np.array([100, 40, 60])
+    told = stop_advice(reached, runs)
+    assert told is not None and "ended 1 of 3 trials at 40 episodes" in told and "25 %" not in told
+    assert "25%" in told and "reached 50%" in told and "--episode.stop-window 0" in told
+    assert stop_advice(reached[[0, 2]], runs[[0, 2]]) is None
+    assert stop_advice(reached, np.array([100, 100, 100])) is None  # none stopped
+
+
 def test_obstacle_advice_does_not_repeat_what_the_run_already_did() -> None:
     from latentrl.verdict import end_advice
 

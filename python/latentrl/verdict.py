@@ -99,6 +99,23 @@ def timeout_advice(policy: Any, returns: NDArray[np.float64]) -> str:
             "wander (failures.png) the learnt value is flat; more --episodes, or starts through there")
 
 
+def stop_advice(reached: NDArray[np.bool_], runs: NDArray[np.int_]) -> str | None:
+    """What to try when the stopping rule ended a trial below where another got (`reached`: the
+    training record, trials × budget; `runs`: the episodes each trial ran): a trial that stopped
+    short of the budget and reached the target in the last tenth of its episodes more than
+    `RISING` less often than the best trial did in its own was read as a plateau in a dip. The
+    zoo's snake: two of four trials stopped at 900 episodes (23 and 16 %) while one ran on to
+    58 %; with every episode run (`--episode.stop-window 0`) greedy reach went from 31 to 45 %."""
+    late = np.array([row[r - max(1, r // 10):r].mean() for row, r in zip(reached, runs)])
+    behind = (runs < reached.shape[1]) & (late < late.max() - RISING)
+    if not behind.any():
+        return None
+    return (f"the stopping rule ended {int(behind.sum())} of {len(runs)} trials at "
+            f"{', '.join(str(int(r)) for r in runs[behind])} episodes, reaching the target in "
+            f"{', '.join(f'{v:.0%}' for v in late[behind])} of their last tenth, where another trial reached "
+            f"{late.max():.0%}: --episode.stop-window 0 runs every episode of the budget")
+
+
 def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings: Any = None) -> Verdict:
     """The verdict of the module docs on `policy` (a LatentPolicy with its training record), from
     `episodes` rollouts per trial and policy; `findings`: a `check.CheckReport` whose advice joins."""
@@ -140,6 +157,9 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
                     ~last(reached, fifth)][failing == names.index("timeout")]))
         if rising:
             steps.append("the reach rate was still rising at the end: more --episodes")
+        stopped = stop_advice(reached, runs)
+        if stopped is not None:
+            steps.append(stopped)
         if verdict == "never reached it":
             steps.append("run latentrl check: its target and paths findings say whether the target can be reached")
         if findings is not None:
