@@ -4,7 +4,7 @@ learning on a short budget, and a latent learner that keeps the grip."""
 import numpy as np
 import pytest
 
-from latentrl._native import GpMap, InvalidInputError, run_bimanual_trials
+from latentrl._native import GpMap, InvalidInputError, bimanual_config, run_bimanual_trials
 from learning import CONTROL_ALPHA, assert_separated
 
 LOW = np.array([-0.4, -0.4])
@@ -97,7 +97,8 @@ def test_same_seed_same_arrays_and_shapes():
     # A resumed sweep reproduces trial 2 exactly.
     d = run_bimanual_trials(**dict(kwargs, n_trials=1, first_trial=2))
     np.testing.assert_array_equal(d["returns"][0], a["returns"][2])
-    assert a["learner"]["alpha"] == 0.9 and a["plant"]["max_steps"] == 20
+    plant, learner = bimanual_config(kwargs["plant"])
+    assert learner["alpha"] == 0.9 and plant["max_steps"] == 20
 
 
 def test_full_space_learner_learns_with_forgiving_tolerance():
