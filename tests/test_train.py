@@ -93,6 +93,16 @@ def test_same_seed_same_policy_and_value_matches_weights(arms_model: GPLVM) -> N
     )
 
 
+def test_a_trial_is_the_same_however_many_trials_run(arms_model: GPLVM) -> None:
+    """`TrainPreset.trials` is 2 because trial 0, the one `act` uses, is the same bits with 4:
+    more trials only add others beside it."""
+    two, four = (train_latent_policy(arms_model, trials=n, episodes=4, overrides={"episode.max_steps": 30},
+                                     test_episodes=1, seed=3) for n in (2, 4))
+    np.testing.assert_array_equal(two.weights, four.weights[:2])
+    np.testing.assert_array_equal(two.returns, four.returns[:2])
+    np.testing.assert_array_equal(two.test_returns, four.test_returns[:2])
+
+
 @pytest.mark.parametrize("move_correction", [False, True])
 def test_a_saved_policy_loads_acts_and_rolls_out_the_same(arms_model: GPLVM, tmp_path: Path, move_correction: bool) -> None:
     overrides = {"episode.max_steps": 30, "learner.move_correction": move_correction}

@@ -142,11 +142,13 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
 
 
 def check_task(task: Task, demos: NDArray[np.float64], model: Any, low: NDArray[np.float64],
-               high: NDArray[np.float64], *, budget: tuple[int, int] = (4, 2000), threads: int = 1,
+               high: NDArray[np.float64], *, budget: tuple[int, int] | None = None, threads: int = 1,
                max_points: int = MAX_POINTS, progress: Any = None) -> CheckReport:
     """The findings of the module docs for `task` with `demos` (N, D) in its joint order, the
     fitted GPLVM `model` and the latent box [`low`, `high`]; `budget` (trials, episodes) is the
-    training run costed, on `threads` threads."""
+    training run costed (default: `TrainPreset`'s), on `threads` threads."""
+    from latentrl.run_settings import TrainPreset
+
     findings = [demo_finding(task, demos), fit_finding(model)]
     if findings[0].verdict == "will not learn":  # the rest would measure a space the task refuses
         return CheckReport(task.name, tuple(findings))
@@ -155,7 +157,7 @@ def check_task(task: Task, demos: NDArray[np.float64], model: Any, low: NDArray[
     findings += survey_findings(task, survey)
     findings.append(encoder_finding(model, survey))
     findings.append(servo_finding(task, demos))
-    findings.append(cost_finding(task, demos, budget, threads))
+    findings.append(cost_finding(task, demos, budget or (TrainPreset.trials, TrainPreset.episodes), threads))
     return CheckReport(task.name, tuple(findings))
 
 

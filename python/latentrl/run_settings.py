@@ -128,8 +128,10 @@ def with_overrides(preset: Any, overrides: Mapping[str, Any]) -> Any:
 class TrainPreset(LatentRun):
     """Training a latent policy on a task of your own (`latentrl train`)."""
 
-    trials: int = 4
-    """Independent RL trials; the policy keeps each trial's weights (ours: 4)."""
+    trials: int = 2
+    """Independent RL trials; the policy keeps each trial's weights and acts with trial 0's (ours: 2,
+    which run side by side on 2 cores: 4 took the zoo's biped two rounds, ≈ 14 minutes, for the
+    same trial 0, bit for bit; `examples/zoo/README.md`, "Session 9")."""
     episodes: int = 2000
     """Training episodes per trial (ours: 2000)."""
     test_episodes: int = 20
@@ -151,4 +153,4 @@ class TrainPreset(LatentRun):
     def quick(cls) -> TrainPreset:
         """A short run to see that it learns: 2 trials × 300 episodes, 10 test episodes (the
         learner's step and w₀ are derived where the task is silent: `latentrl.derive`)."""
-        return dataclasses.replace(cls(), trials=2, episodes=300, test_episodes=10)
+        return dataclasses.replace(cls(), episodes=300, test_episodes=10)
