@@ -32,7 +32,8 @@ def edit(out, change):
     ("change", "says"),
     [
         (lambda m: m["preset"].update(seed=7), "seed: 0 in returns.npz, 7 in results.json"),
-        (lambda m: m["preset"]["task"].update({"learner.alpha": 0.5}), "task: "),
+        (lambda m: m["preset"]["task"].update({"learner.alpha": 0.5}),
+         "learner.alpha: not given in returns.npz, 0.5 in results.json"),
         (lambda m: m["preset"].update(trials=3), "trials: 2 in returns.npz, 3 in results.json"),
     ],
     ids=["seed", "a task key", "trials"],

@@ -77,6 +77,19 @@ def test_an_edited_input_is_refused_by_name(run, edit, name):
     assert (folder / "out" / "returns.npz").read_bytes() == before
 
 
+def test_a_resume_with_other_flags_is_refused_naming_each_change(run):
+    """A resume with another flag said only "holds a run of a different preset", naming nothing:
+    it names each field and task key that differs, as the user gave it, and writes nothing."""
+    folder, resume = run
+    before = (folder / "out" / "returns.npz").read_bytes()
+    changed = [a if a != "3" else "4" for a in resume]  # --episodes 3 → 4
+    result = latentrl(*changed, "--learner.alpha", "0.5")
+    assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
+    assert "different preset (episodes: 3 in the run, 4 now; learner.alpha: not given in the run, 0.5 now)" \
+        in result.stderr, result.stderr
+    assert (folder / "out" / "returns.npz").read_bytes() == before
+
+
 @pytest.mark.parametrize(("edit", "name"), [(reorder_demos, "demos"), (edit_task, "task file")])
 def test_a_run_whose_inputs_changed_is_not_replayed(run, tmp_path, edit, name):
     """Issue #38: replay reads the run back from its inputs; an edited input is refused by name,

@@ -141,11 +141,10 @@ class RunFolder:
         meta = self.results()
         recorded = self.recorded_task()
         ran = ran_with(recorded) if recorded is not None else {}
-        if edited_fields(meta.get("preset") or {}, as_saved(plan), ran):
-            raise ValueError(
-                f"{self.path} holds a run of a different preset; choose another --out "
-                "or delete it (only a run of the same preset is continued)"
-            )
+        changes = edits(meta.get("preset") or {}, as_saved(plan), ran, "in the run", "now")
+        if changes:
+            raise ValueError(f"{self.path} holds a run of a different preset ({changes}); choose another --out "
+                             "or delete it (only a run of the same preset is continued)")
         if not self.arrays_path.exists():
             return {}, None
         arrays = self.arrays()
@@ -157,9 +156,8 @@ class RunFolder:
         edited fields otherwise (mixing would be silently wrong)."""
         if PRESET_KEY in arrays:
             saved, now = saved_preset(self.arrays_path, arrays[PRESET_KEY]), as_saved(plan)
-            edited = edited_fields(saved, now, ran)
-            if edited:
-                changes = ", ".join(f"{k}: {saved.get(k)!r} in returns.npz, {now.get(k)!r} in results.json" for k in edited)
+            changes = edits(saved, now, ran, "in returns.npz", "in results.json")
+            if changes:
                 raise ValueError(f"{self.path}/results.json was edited after its trials ran ({changes}); resume refuses "
                                  "to mix the two: restore the file, or start a new run with --out")
 
@@ -222,15 +220,25 @@ def saved_preset(path: Path, value: np.ndarray) -> dict[str, Any]:
 
 
 def edited_fields(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any]) -> list[str]:
-    """The preset fields that differ between `saved` and `now`. A task override that only
-    restores what the trials ran with (`ran`: `task.ran_with` of the recorded task, empty if none
-    was recorded) is not an edit: `saved_runs.saved_run` adds those when a shipped task changed since."""
+    """The preset fields that differ between `saved` and `now`, and the task keys (by path,
+    ``learner.alpha``) its `task` overrides differ in. A task override that only restores what
+    the trials ran with (`ran`: `task.ran_with` of the recorded task, empty if none was recorded)
+    is not an edit: `saved_runs.saved_run` adds those when a shipped task changed since."""
     edited = [k for k in set(saved) | set(now) if k != "task" and saved.get(k) != now.get(k)]
     before, after = saved.get("task") or {}, now.get("task") or {}
     restored = {k for k in set(after) - set(before) if k in ran and ran[k] == after[k]}
-    if {k for k in set(before) | set(after) if before.get(k) != after.get(k)} - restored:
-        edited.append("task")
+    edited += [k for k in set(before) | set(after) if before.get(k) != after.get(k) and k not in restored]
     return sorted(edited)
+
+
+def edits(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any], was: str, is_: str) -> str:
+    """The `edited_fields` as the user wrote them, "episodes: 150 in the run, 200 now" (a task
+    override by its key path; one not given: "not given"), joined by "; "; "" if none."""
+    def value(preset: Mapping[str, Any], key: str) -> str:
+        holder = preset if key in preset else preset.get("task") or {}
+        return repr(holder[key]) if key in holder else "not given"
+
+    return "; ".join(f"{k}: {value(saved, k)} {was}, {value(now, k)} {is_}" for k in edited_fields(saved, now, ran))
 
 
 def check_inputs(recorded: Mapping[str, str], now: Mapping[str, str], out: Path) -> None:
