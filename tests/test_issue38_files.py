@@ -86,6 +86,22 @@ def test_the_cli_given_a_fifo_exits_1_naming_it(fifo: Path, tmp_path: Path) -> N
     assert "Traceback" not in result.stderr
 
 
+@pytest.mark.parametrize("flag", ["task", "--demos", "--model"])
+def test_train_given_a_symlink_loop_exits_1_naming_the_flag(tmp_path: Path, flag: str) -> None:
+    """A loop of symbolic links as the task file, --demos or --model was a RuntimeError traceback
+    (`Path.resolve`)."""
+    (tmp_path / "a.csv").symlink_to(tmp_path / "b.csv")
+    (tmp_path / "b.csv").symlink_to(tmp_path / "a.csv")
+    loop = str(tmp_path / "a.csv")
+    given = {"task": str(EXAMPLE / "glass_arm.toml"), "--demos": str(EXAMPLE / "demos.csv"), "--model": None}
+    given[flag] = loop
+    args = [given["task"], "--demos", given["--demos"], *(["--model", loop] if flag == "--model" else [])]
+    result = cli("train", *args, "--out", str(tmp_path / "run"), "--quick", "--no-progress")
+    assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
+    assert f"{'task file' if flag == 'task' else flag} {loop}: is a loop of symbolic links" in result.stderr
+    assert not (tmp_path / "run").exists()
+
+
 def test_devices_and_directories_are_refused_by_kind(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="is not a regular file \\(a character device\\)"):
         Task.load("/dev/zero")

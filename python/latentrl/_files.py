@@ -16,9 +16,11 @@ cannot be opened raises the OSError of ``os.open`` (it names the file).
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import stat
 from collections.abc import Iterator
+from pathlib import Path
 from typing import BinaryIO
 
 MAX_TASK_FILE_BYTES = 1 << 20
@@ -99,3 +101,14 @@ def read_text(path: str | os.PathLike[str], cap: int, what: str) -> str:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
         raise ValueError(f"is not UTF-8 text: {err}") from None
+
+
+def absolute(path: str | os.PathLike[str], what: str) -> Path:
+    """`path` made absolute with its symbolic links resolved, or a ValueError naming it (`what`:
+    how the user gave it, "--demos") if they loop (Python's own error was a RuntimeError)."""
+    try:
+        return Path(path).resolve()
+    except (RuntimeError, OSError) as err:  # Python < 3.13: RuntimeError; 3.13: OSError (ELOOP)
+        if isinstance(err, OSError) and err.errno != errno.ELOOP:
+            raise
+        raise ValueError(f"{what} {path}: is a loop of symbolic links") from None

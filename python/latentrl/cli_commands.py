@@ -76,8 +76,11 @@ def _train(args: argparse.Namespace) -> int:
     from latentrl.experiments.training import run_training
 
     # Absolute: the run folder is read back (resume, replay, rollout) from any working directory.
-    run = _training_run(args, {"task_file": str(args.task.resolve()), "demos": str(args.demos.resolve()),
-                               "model": str(args.model.resolve()) if args.model else ""})
+    from latentrl._files import absolute
+
+    run = _training_run(args, {"task_file": str(absolute(args.task, "task file")),
+                               "demos": str(absolute(args.demos, "--demos")),
+                               "model": str(absolute(args.model, "--model")) if args.model else ""})
     meta_path = args.out / "results.json"
     if meta_path.is_file() and not args.resume:
         raise ValueError(f"{args.out} holds a run already: add --resume to continue it, or choose another --out")
