@@ -170,3 +170,16 @@ def test_a_recorded_posture_past_a_joint_stop_can_be_drawn_but_not_started_from(
     assert 0 < moved < 3e-3, moved  # 3 mrad on a shin of < 0.1 m
     code = plant.reset(posture)
     assert code is not None and end_reasons()[code] == "box_exit"
+
+
+def test_a_task_file_with_a_byte_order_mark_loads(tmp_path):
+    """A UTF-8 byte-order mark (Windows editors write one): the native reader skipped it, the
+    Python reader of the file's keys failed with "Invalid statement (at line 1, column 1)", naming
+    no file."""
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    (tmp_path / "glass_arm.urdf").write_bytes((example / "glass_arm.urdf").read_bytes())
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + (example / "glass_arm.toml").read_bytes())
+    task = Task.load(path)
+    assert task.given == Task.load(example / "glass_arm.toml").given
+    assert task.to_dict() == Task.load(example / "glass_arm.toml").to_dict()

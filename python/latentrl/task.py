@@ -103,7 +103,10 @@ class Task:
             text = read_text(path, MAX_TASK_FILE_BYTES, "a task file")  # it may have changed since
         except ValueError as err:
             raise ValueError(f"{path}: {err}") from None
-        written = key_paths(tomllib.loads(text))
+        try:  # a byte-order mark (Windows editors write one) is no TOML, but the native reader skips it
+            written = key_paths(tomllib.loads(text.removeprefix("\ufeff")))
+        except tomllib.TOMLDecodeError as err:
+            raise ValueError(f"{path}: {err}") from None
         return cls(native, path.parent, frozenset(written))
 
     @classmethod
