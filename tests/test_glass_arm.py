@@ -249,3 +249,23 @@ def test_a_run_reads_back_under_a_version_with_a_new_model_parameter(runs, monke
     get_params = GPLVM.get_params
     monkeypatch.setattr(GPLVM, "get_params", lambda self, deep=True: {**get_params(self, deep), "future": None})
     prepared(TrainRun(**fields), out)  # raised "its model changed since the run"
+
+
+def test_a_disk_that_fills_at_the_figures_keeps_the_policy(monkeypatch, tmp_path):
+    """The policy was written after the figures: a full disk there left a run whose trials were
+    saved but had no policy.npz (`report` and `rollout` refused it) while the message offered
+    `latentrl plot`, which does not write one."""
+    import errno
+
+    import latentrl.plots
+    from latentrl.experiments.training import TrainRun, run_training
+
+    def full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(latentrl.plots, "save_figure", full)
+    run = TrainRun(task_file=str(EXAMPLE / "glass_arm.toml"), demos=str(EXAMPLE / "demos.csv"), trials=1, episodes=3,
+                   test_episodes=1, task={"episode.max_steps": 10})
+    with pytest.raises(OSError, match="draws its figures again"):
+        run_training(run, tmp_path / "out", progress=False)
+    assert LatentPolicy.load(tmp_path / "out" / "policy.npz").weights.shape[0] == 1

@@ -280,9 +280,18 @@ def run_training(run: TrainRun, out_dir: Path | str, *, progress: bool = True) -
 
     from latentrl.experiments.runner import run_rl
 
-    meta = run_rl(run, out_dir, setup=setup, figures=figures, progress=progress)
-    save_policy(run, Path(out_dir))
-    return meta
+    return run_rl(run, out_dir, setup=setup, figures=_policy_and_figures, progress=progress)
+
+
+def _policy_and_figures(run: TrainRun, arrays: Mapping[str, np.ndarray], run_dir: Path, out: Path) -> None:
+    """`policy.npz` (`save_policy`), then the `figures`: a disk that fills while they are drawn
+    keeps the policy (it was written after them, so `report` and `rollout` found none)."""
+    try:
+        save_policy(run, run_dir)
+    except OSError as err:
+        raise type(err)(err.errno, f"{err.strerror or err}; the same latentrl train command with --resume "
+                                   "writes it once there is room") from err
+    figures(run, arrays, run_dir, out)
 
 
 def figures(run: TrainRun, arrays: Mapping[str, np.ndarray], run_dir: Path, out: Path) -> None:
