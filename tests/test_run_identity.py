@@ -77,6 +77,22 @@ def test_an_edited_input_is_refused_by_name(run, edit, name):
     assert (folder / "out" / "returns.npz").read_bytes() == before
 
 
+@pytest.mark.parametrize(("edit", "name"), [(edit_task, "task file"), (edit_urdf, "urdf"), (reorder_demos, "demos")])
+def test_an_edited_input_is_refused_before_the_fit(run, monkeypatch, capsys, edit, name):
+    """The refusal came after the GPLVM fit and the derived settings (seconds to minutes on a
+    7-DoF arm, and "derived …" lines printed first): the task file, URDF and demos are compared
+    before anything is fitted."""
+    from latentrl import cli
+    from latentrl.gplvm import GPLVM
+
+    folder, resume = run
+    edit(folder)
+    monkeypatch.setattr(GPLVM, "fit", lambda *a, **k: pytest.fail("fitted before the inputs were compared"))
+    assert cli.main(resume) == 1
+    out, err = capsys.readouterr()
+    assert f"its {name} changed since the run (sha256 " in err and out == "", (out, err)
+
+
 def test_a_resume_with_other_flags_is_refused_naming_each_change(run):
     """A resume with another flag said only "holds a run of a different preset", naming nothing:
     it names each field and task key that differs, as the user gave it, and writes nothing."""

@@ -73,20 +73,19 @@ def _interruptible(work: Callable[[], object], out: Path, resume_command: str) -
 def _train(args: argparse.Namespace) -> int:
     import matplotlib.pyplot  # noqa: F401  (the figures' [plot] extra: missing, exit 1 before any work)
 
-    from latentrl.experiments.training import run_training
+    from latentrl._files import absolute
+    from latentrl.experiments.training import check_resumable, prepared, run_training
 
     # Absolute: the run folder is read back (resume, replay, rollout) from any working directory.
-    from latentrl._files import absolute
-
     run = _training_run(args, {"task_file": str(absolute(args.task, "task file")),
                                "demos": str(absolute(args.demos, "--demos")),
                                "model": str(absolute(args.model, "--model")) if args.model else ""})
     meta_path = args.out / "results.json"
     if meta_path.is_file() and not args.resume:
         raise ValueError(f"{args.out} holds a run already: add --resume to continue it, or choose another --out")
+    if args.resume:  # the same preset and inputs, before the fit and the derived settings
+        check_resumable(run, args.out)
     run.validate()  # every file, key and column checked before anything is written
-    from latentrl.experiments.training import prepared
-
     task, *_, settings = prepared(run)
     for warning in task.warnings:
         print(f"latentrl: warning: {warning}", file=sys.stderr)

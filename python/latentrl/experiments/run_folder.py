@@ -139,17 +139,24 @@ class RunFolder:
         if not self.results_path.exists():
             return {}, None
         meta = self.results()
-        recorded = self.recorded_task()
-        ran = ran_with(recorded) if recorded is not None else {}
-        changes = edits(meta.get("preset") or {}, as_saved(plan), ran, "in the run", "now")
-        if changes:
-            raise ValueError(f"{self.path} holds a run of a different preset ({changes}); choose another --out "
-                             "or delete it (only a run of the same preset is continued)")
+        self.check_preset(plan)
         if not self.arrays_path.exists():
             return {}, None
         arrays = self.arrays()
-        self._check_saved_run(plan, arrays, ran)
+        recorded = self.recorded_task()
+        self._check_saved_run(plan, arrays, ran_with(recorded) if recorded is not None else {})
         return arrays, meta
+
+    def check_preset(self, plan: dict[str, Any]) -> None:
+        """The run saved here is of the preset `plan` (`describe`); a ValueError naming each field
+        and task key that differs otherwise. Reads results.json only: `train --resume` asks before
+        its fit."""
+        recorded = self.recorded_task()
+        ran = ran_with(recorded) if recorded is not None else {}
+        changes = edits(self.preset(), as_saved(plan), ran, "in the run", "now")
+        if changes:
+            raise ValueError(f"{self.path} holds a run of a different preset ({changes}); choose another --out "
+                             "or delete it (only a run of the same preset is continued)")
 
     def _check_saved_run(self, plan: dict[str, Any], arrays: Mapping[str, np.ndarray], ran: Mapping[str, Any]) -> None:
         """The arrays of a run being continued were computed with `plan`; a ValueError naming the

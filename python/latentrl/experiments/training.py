@@ -51,14 +51,20 @@ class TrainRun(TrainPreset, DemoOptions):
 
 
 @lru_cache(maxsize=2)
-def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, model: str,
-          seed: int, max_iter: int, encoder: str, spacing: str) -> tuple[Task, np.ndarray, GPLVM]:
+def _inputs(task_file: str, overrides: str, demos: str, options: DemoOptions) -> tuple[Task, np.ndarray]:
+    """The task with its overrides and the demo postures in its joints' order."""
     task = Task.load(task_file).replace(json.loads(overrides))
     # A recording's other joints (a gripper, a wheel) are dropped; a file of postures names the robot's.
     recorded = recording_kind(Path(demos)) is not None
     loaded = load_demos(demos, min_postures=3, expected_joints=task.joint_names if recorded else None,
                         **options.load_kwargs())
-    postures = task.demo_postures(loaded.joint_names, loaded.postures, demos)
+    return task, task.demo_postures(loaded.joint_names, loaded.postures, demos)
+
+
+@lru_cache(maxsize=2)
+def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, model: str,
+          seed: int, max_iter: int, encoder: str, spacing: str) -> tuple[Task, np.ndarray, GPLVM]:
+    task, postures = _inputs(task_file, overrides, demos, options)
     gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder,
                                                   spacing=spacing)
     if model:
@@ -88,12 +94,8 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
     from latentrl.experiments.latent_runs import Fitted, run_fit
     from latentrl.experiments.run_folder import RunFolder
 
-    overrides = json.dumps(run.task, sort_keys=True)  # hashable for the cache, list values too
-    options = DemoOptions(**{f.name: getattr(run, f.name) for f in dataclasses.fields(DemoOptions)})
-
     def load(spacing: str) -> tuple[Task, np.ndarray, GPLVM]:
-        return _load(run.task_file, overrides, run.demos, options, run.model, run.seed, run.gplvm_max_iter,
-                     run.encoder, spacing)
+        return _load(*_keys(run), run.model, run.seed, run.gplvm_max_iter, run.encoder, spacing)
 
     auto = run.latent_spacing == "auto"
     task, demos, model = load("fit" if auto else run.latent_spacing)
@@ -109,6 +111,26 @@ def prepared(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, 
             folder.check_inputs(input_digests(run.task_file, task, demos, model._arrays() if saved is None else saved))
     settings = _derived(task, model, demos, run.latent_margin, even)
     return applied(task, settings), demos, model, settings
+
+
+def _keys(run: TrainRun) -> tuple[str, str, str, DemoOptions]:
+    """`_inputs`' arguments for `run`: the task file, its overrides (as JSON: hashable for the
+    cache, list values too), the demos and how they are read."""
+    options = DemoOptions(**{f.name: getattr(run, f.name) for f in dataclasses.fields(DemoOptions)})
+    return run.task_file, json.dumps(run.task, sort_keys=True), run.demos, options
+
+
+def check_resumable(run: TrainRun, out: Path) -> None:
+    """Before the fit: the run saved in `out`, if any, is of `run`'s preset and was made from its
+    task file, URDF and demos (their recorded digests); a ValueError naming what differs. The
+    model's digest is compared once the run's model is read (`prepared`)."""
+    from latentrl.experiments.presets import describe
+    from latentrl.experiments.run_folder import RunFolder
+
+    folder = RunFolder(out)
+    if folder.results_path.is_file():
+        folder.check_preset(describe(run))
+        folder.check_inputs(input_digests(run.task_file, *_inputs(*_keys(run))))
 
 
 def _derived(task: Task, model: GPLVM, demos: np.ndarray, margin: float,
@@ -148,12 +170,14 @@ def setup(run: TrainRun, out: Path | None = None) -> Setup:
     return built
 
 
-def input_digests(task_file: str, task: Task, demos: np.ndarray, model: Mapping[str, np.ndarray]) -> dict[str, str]:
+def input_digests(task_file: str, task: Task, demos: np.ndarray,
+                  model: Mapping[str, np.ndarray] | None = None) -> dict[str, str]:
     """SHA-256 of what a run is made from: the task file's and the URDF's bytes, its collision
     meshes' (by file name and bytes, if it has any: a moved robot folder keeps them), the demo
     postures as the learner gets them (joint order, float64) and the GPLVM's arrays as saved
     (`model`: a run's gplvm.npz as read, so a parameter a later version adds does not change
-    it); a resume compares them (`RunFolder.check_inputs`)."""
+    it; None: no model digest, as `check_resumable` asks before the fit); a resume compares them
+    (`RunFolder.check_inputs`)."""
     import hashlib  # OpenSSL: loaded by a run, not by `train --help`
 
     def sha(data: bytes) -> str:
@@ -163,8 +187,9 @@ def input_digests(task_file: str, task: Task, demos: np.ndarray, model: Mapping[
         "task file": sha(read_bounded(task_file, MAX_TASK_FILE_BYTES, "a task file")),
         "urdf": sha(read_bounded(task.urdf_path, MAX_URDF_BYTES, "a URDF")),
         "demos": sha(np.ascontiguousarray(demos, dtype=np.float64).tobytes()),
-        "model": sha(b"".join(k.encode() + np.ascontiguousarray(model[k]).tobytes() for k in sorted(model))),
     }
+    if model is not None:
+        digests["model"] = sha(b"".join(k.encode() + np.ascontiguousarray(model[k]).tobytes() for k in sorted(model)))
     meshes = sorted({Path(s["file"]) for s in task._native.collision_shapes() if s.get("file")}, key=lambda p: p.name)
     if meshes:
         digests["meshes"] = sha(b"".join(m.name.encode() + read_bounded(m, MAX_MESH_BYTES, "a mesh") for m in meshes))
