@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from latentrl import GPLVM, LatentPolicy
+from latentrl import GPLVM, LatentPolicy, Task, load_demos
 from latentrl.datasets import arm_postures
 from latentrl.replay import check_replay_arrays, rollout_episode
 from latentrl import train_latent_policy
@@ -208,3 +208,22 @@ import latentrl
         assert (result.returncode, result.stderr) == (130, "latentrl: interrupted; nothing was written\n")
     else:
         assert result.returncode != 0 and "Traceback" in result.stderr and "KeyboardInterrupt" in result.stderr
+
+
+def test_degrees_given_for_demos_in_radians_are_refused(tmp_path: Path) -> None:
+    """`--degrees` on a demo file already in radians shrank every motion 57-fold and trained on
+    it without a word (exit 0); a file in degrees is refused offering `--degrees`."""
+    out = tmp_path / "out"
+    result = subprocess.run(
+        [sys.executable, "-m", "latentrl", "train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"),
+         "--degrees", "--quick", "--no-progress", "--out", str(out)], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 1 and "Traceback" not in result.stderr, result.stderr
+    assert f"{EXAMPLE / 'demos.csv'}: --degrees (degrees=True) was given, but no value lies beyond ±2π" in result.stderr
+    assert "look like radians already" in result.stderr and not out.exists()
+    lines = (EXAMPLE / "demos.csv").read_text().splitlines()
+    degrees = [lines[0], *(",".join(repr(float(np.degrees(float(v)))) for v in line.split(",")) for line in lines[1:])]
+    (tmp_path / "deg.csv").write_text("\n".join(degrees) + "\n")
+    with pytest.raises(ValueError, match=r"look like degrees; give --degrees \(degrees=True\)"):
+        Task.load(EXAMPLE / "glass_arm.toml").demo_postures(tuple(lines[0].split(",")),
+                                                             load_demos(tmp_path / "deg.csv").postures, "deg.csv")
+    assert load_demos(tmp_path / "deg.csv", degrees=True).postures == pytest.approx(load_demos(EXAMPLE / "demos.csv").postures)

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from latentrl._persistence import PathLike, atomic_write, read_npz
 from latentrl.recorded import KINDS, open_recording, read_frames, recording_kind
-from latentrl.recorded.frames import renamed
+from latentrl.recorded.frames import refuse_radians, renamed
 from latentrl.recorded.sampling import farthest_points
 
 
@@ -290,6 +290,7 @@ def _load_file(path: Path, expected_joints: Sequence[str] | None, joint_map: Map
     except RecursionError as err:
         raise ValueError(f"{path}: nested too deeply to read") from err
     if degrees:
+        refuse_radians(demos.postures, str(path))
         demos = Demonstrations(np.radians(demos.postures), demos.joint_names, demos.episodes, demos.frames)
     return demos
 

@@ -203,7 +203,8 @@ class Task:
         raise ValueError(
             f"{where}: posture {rows[0]} (counting from 0) has {joint} = {value:.6g}, beyond ±2π and outside the "
             f"joint's limits [{lower:.6g}, {upper:.6g}] ({len(np.unique(rows))} of {len(postures)} postures like "
-            "it): these look like degrees; write the demonstrations in radians (np.deg2rad)")
+            "it): these look like degrees; give --degrees (degrees=True) or write the demonstrations in radians "
+            "(np.deg2rad)")
 
     @property
     def warnings(self) -> list[str]:

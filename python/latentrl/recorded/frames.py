@@ -27,7 +27,16 @@ are filled into one array an episode at a time; with the copy `Demonstrations` k
 holds at most twice the cap (512 MiB) plus one episode as recorded."""
 
 REVOLUTE_BOUND = 2 * math.pi
-"""A kept joint whose recorded values go beyond ±2π looks like degrees: refused without `degrees`."""
+"""A kept joint whose recorded values go beyond ±2π looks like degrees: refused without `degrees`;
+with it, values none of which goes beyond look like radians already (`refuse_radians`)."""
+
+
+def refuse_radians(values: NDArray[np.float64], where: str) -> None:
+    """A ValueError naming `where` when values said to be degrees all lie within ±2π: they look
+    like radians (converted again, every motion would shrink 57-fold without a word)."""
+    if values.size and not (np.abs(values) > REVOLUTE_BOUND).any():
+        raise ValueError(f"{where}: --degrees (degrees=True) was given, but no value lies beyond ±2π (the largest "
+                         f"is {np.abs(values).max():g}): these look like radians already; drop --degrees")
 
 
 @dataclass(frozen=True)
@@ -166,6 +175,7 @@ def read_frames(recording: Recording, *, expected_joints: Sequence[str] | None =
         _finite(values[start:start + count], kept, episode, step)
         start += count
     if degrees:
+        refuse_radians(values, where)
         np.radians(values, out=values)
     else:
         beyond = np.abs(values) > REVOLUTE_BOUND
