@@ -249,3 +249,13 @@ def test_an_edited_collision_mesh_is_refused_by_name(tmp_path):
     (tmp_path / "hand.stl").write_bytes(bytes(stl))
     result = latentrl(*args, "--resume")
     assert result.returncode == 1 and "its meshes changed since the run (sha256 " in result.stderr, result.stderr
+
+
+def test_a_preset_of_another_kind_is_named_alone():
+    """An Exp 1 run resumed by `train` listed all 15 fields the two kinds of preset differ in."""
+    from latentrl.experiments.run_folder import edits
+
+    exp1 = {"name": "Exp1Preset", "seed": 0, "n_demos": 50, "task": {"learner.step": 0.5}}
+    train = {"name": "TrainRun", "seed": 0, "demos": "d.csv", "task": {}}
+    assert edits(exp1, train, {}, "in the run", "now") == "name: 'Exp1Preset' in the run, 'TrainRun' now"
+    assert edits({**train, "seed": 1}, train, {}, "in the run", "now") == "seed: 1 in the run, 0 now"

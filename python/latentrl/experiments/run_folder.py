@@ -240,12 +240,15 @@ def edited_fields(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping
 
 def edits(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any], was: str, is_: str) -> str:
     """The `edited_fields` as the user wrote them, "episodes: 150 in the run, 200 now" (a task
-    override by its key path; one not given: "not given"), joined by "; "; "" if none."""
+    override by its key path; one not given: "not given"), joined by "; "; "" if none. A preset
+    of another kind (`name`, e.g. an Exp 1 run resumed by `train`) is named alone."""
     def value(preset: Mapping[str, Any], key: str) -> str:
         holder = preset if key in preset else preset.get("task") or {}
         return repr(holder[key]) if key in holder else "not given"
 
-    return "; ".join(f"{k}: {value(saved, k)} {was}, {value(now, k)} {is_}" for k in edited_fields(saved, now, ran))
+    edited = edited_fields(saved, now, ran)
+    return "; ".join(f"{k}: {value(saved, k)} {was}, {value(now, k)} {is_}"
+                     for k in (["name"] if "name" in edited else edited))
 
 
 def check_inputs(recorded: Mapping[str, str], now: Mapping[str, str], out: Path) -> None:
