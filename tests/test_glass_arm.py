@@ -269,3 +269,27 @@ def test_a_disk_that_fills_at_the_figures_keeps_the_policy(monkeypatch, tmp_path
     with pytest.raises(OSError, match="draws its figures again"):
         run_training(run, tmp_path / "out", progress=False)
     assert LatentPolicy.load(tmp_path / "out" / "policy.npz").weights.shape[0] == 1
+
+
+def test_plot_interrupted_between_figures_does_not_say_nothing_was_written(monkeypatch, tmp_path, capsys):
+    """Ctrl-C during `latentrl plot` after its first figure said "interrupted; nothing was
+    written" while returns.png was new."""
+    import latentrl.plots
+    from latentrl.experiments.training import TrainRun, run_training
+
+    run = TrainRun(task_file=str(EXAMPLE / "glass_arm.toml"), demos=str(EXAMPLE / "demos.csv"), trials=1, episodes=3,
+                   test_episodes=1, task={"episode.max_steps": 10})
+    run_training(run, tmp_path / "out", progress=False)
+    save_figure, saved = latentrl.plots.save_figure, []
+
+    def then_ctrl_c(fig, out, name):
+        if saved:
+            raise KeyboardInterrupt
+        saved.append(name)
+        save_figure(fig, out, name)
+
+    monkeypatch.setattr(latentrl.plots, "save_figure", then_ctrl_c)
+    assert cli.main(["plot", str(tmp_path / "out"), "--out", str(tmp_path / "figs")]) == 130
+    err = capsys.readouterr().err
+    assert "nothing was written" not in err and f"the figures drawn so far are in {tmp_path / 'figs'}" in err, err
+    assert {p.name for p in (tmp_path / "figs").iterdir()} == {"returns.png", "returns.pdf"}

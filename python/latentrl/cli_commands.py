@@ -232,14 +232,21 @@ def _plot(args: argparse.Namespace) -> int:
     if not done:
         raise ValueError(f"{args.results}: no finished trial to plot")
     out = args.out or args.results
+    figures: Callable[[Any, Any, Path, Path], None]
     if name == "train":
-        from latentrl.experiments.training import figures
+        from latentrl.experiments.training import figures as train_figures
 
-        figures(preset, arrays, args.results, out)
+        figures = train_figures
     else:
         rl = experiments()[name].rl
         assert rl is not None  # saved_run finds RL experiments only
-        rl.figures(preset, arrays, args.results, out)
+        figures = rl.figures
+    try:
+        figures(preset, arrays, args.results, out)
+    except KeyboardInterrupt:  # each figure is written whole (atomically): some may be new already
+        print(f"latentrl: interrupted; the figures drawn so far are in {out}, the others as they were: "
+              f"`latentrl plot {args.results}` draws them all again", file=sys.stderr)
+        return 130
     counts = ", ".join(f"{learner} {n} of {preset.trials}" for learner, n in done.items())
     print(f"figures of {name} ({counts} trials) in {out}")
     return 0
