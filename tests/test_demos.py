@@ -173,3 +173,15 @@ def test_save_rejects_unknown_extension_and_keeps_the_old_file_on_failure(tmp_pa
     with pytest.raises(RuntimeError, match="disk full"):
         save_demos(demos(7), path)
     assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["d.json"]
+
+
+def test_a_csv_that_is_not_utf8_is_refused_naming_its_line(tmp_path):
+    """A Latin-1 CSV (a spreadsheet's export) said "'utf-8' codec can't decode byte 0xe9 in
+    position 32", a byte offset; a byte-order mark and CRLF line ends are read as before."""
+    text = "a,b\r\n0.1,0.2\r\n0.3,0.4\r\n"
+    (tmp_path / "latin1.csv").write_bytes(text.encode() + "0.5,0.6 # café\r\n".encode("latin-1"))
+    with pytest.raises(ValueError, match=r"latin1.csv: line 4: byte 0xe9 is not UTF-8 text; save the file as UTF-8"):
+        load_demos(tmp_path / "latin1.csv")
+    (tmp_path / "bom.csv").write_bytes(b"\xef\xbb\xbf" + text.encode())
+    demos = load_demos(tmp_path / "bom.csv")
+    assert demos.joint_names == ("a", "b") and demos.postures.tolist() == [[0.1, 0.2], [0.3, 0.4]]

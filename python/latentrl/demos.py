@@ -12,6 +12,7 @@ Formats (by extension):
 
 from __future__ import annotations
 
+import codecs
 import csv
 import io
 import json
@@ -111,9 +112,15 @@ def _table(rows: Sequence[tuple[str, Sequence[Any]]], names: Sequence[str]) -> N
 
 
 def _read_csv(path: Path) -> Demonstrations:
-    with open(path, newline="", encoding="utf-8-sig") as fh:
-        reader = csv.reader(fh)
-        lines = [(reader.line_num, row) for row in reader if row]
+    data = path.read_bytes().removeprefix(codecs.BOM_UTF8)
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:  # Latin-1 from a spreadsheet: say which line, not which byte
+        line = data.count(b"\n", 0, err.start) + 1
+        raise ValueError(f"line {line}: byte {data[err.start]:#04x} is not UTF-8 text; save the file as UTF-8 (a "
+                         "spreadsheet's 'CSV UTF-8')") from None
+    reader = csv.reader(io.StringIO(text, newline=""))
+    lines = [(reader.line_num, row) for row in reader if row]
     if not lines:
         raise ValueError("empty file (no header row)")
     (_, header), body = lines[0], lines[1:]
