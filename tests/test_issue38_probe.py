@@ -227,3 +227,26 @@ def test_degrees_given_for_demos_in_radians_are_refused(tmp_path: Path) -> None:
         Task.load(EXAMPLE / "glass_arm.toml").demo_postures(tuple(lines[0].split(",")),
                                                              load_demos(tmp_path / "deg.csv").postures, "deg.csv")
     assert load_demos(tmp_path / "deg.csv", degrees=True).postures == pytest.approx(load_demos(EXAMPLE / "demos.csv").postures)
+
+
+def test_a_write_to_a_read_only_folder_names_the_file_written(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """On a read-only file system the cleanup's unlink of the temporary file (missing) raised
+    EROFS itself, so `latentrl plot` into a read-only run folder said "Read-only file system:
+    '…/.returns.png.<hex>.tmp'", naming a file the user never asked for."""
+    import errno
+
+    from latentrl._persistence import atomic_path, atomic_write
+
+    def read_only(self: Path, missing_ok: bool = False) -> None:
+        raise OSError(errno.EROFS, "Read-only file system", str(self))
+
+    def fail(fh: object) -> None:
+        raise OSError(errno.EROFS, "Read-only file system")
+
+    monkeypatch.setattr(Path, "unlink", read_only)
+    target = tmp_path / "returns.png"
+    with pytest.raises(OSError, match=f"^\\[Errno 30\\] cannot write {re.escape(str(target))}: Read-only file system$"):
+        atomic_write(target, fail)
+    with pytest.raises(OSError, match=f"cannot write {re.escape(str(target))}: Read-only file system$"):
+        with atomic_path(target):
+            fail(None)

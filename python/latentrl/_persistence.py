@@ -52,7 +52,7 @@ def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
                 os.fsync(fh.fileno())
             os.replace(tmp, path)
     except BaseException:
-        tmp.unlink(missing_ok=True)
+        _remove(tmp)
         raise
 
 
@@ -69,6 +69,14 @@ def atomic_path(path: PathLike) -> Iterator[Path]:
             yield tmp
             os.replace(tmp, path)
     finally:
+        _remove(tmp)
+
+
+def _remove(tmp: Path) -> None:
+    """Removes the temporary file of a write that failed, if it can: on a read-only file system
+    even a missing file's unlink is EROFS, which hid the write's own error (naming the temporary
+    file, not the one written)."""
+    with contextlib.suppress(OSError):
         tmp.unlink(missing_ok=True)
 
 
