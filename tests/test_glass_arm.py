@@ -293,3 +293,24 @@ def test_plot_interrupted_between_figures_does_not_say_nothing_was_written(monke
     err = capsys.readouterr().err
     assert "nothing was written" not in err and f"the figures drawn so far are in {tmp_path / 'figs'}" in err, err
     assert {p.name for p in (tmp_path / "figs").iterdir()} == {"returns.png", "returns.pdf"}
+
+
+def test_a_rollout_cut_between_its_two_files_leaves_no_stale_summary(monkeypatch, tmp_path, capsys):
+    """A second `latentrl rollout` into the same --out killed between rollout.npz and rollout.json
+    left the first rollout's summary beside the second's episodes (replay showed them as the
+    first's); now no summary is left, which replay refuses by name."""
+    import latentrl.results
+    from latentrl.experiments.training import TrainRun, run_training
+
+    run = TrainRun(task_file=str(EXAMPLE / "glass_arm.toml"), demos=str(EXAMPLE / "demos.csv"), trials=1, episodes=3,
+                   test_episodes=1, task={"episode.max_steps": 10})
+    run_training(run, tmp_path / "run", progress=False)
+    rollout = ["rollout", str(tmp_path / "run"), "--episodes", "2", "--out", str(tmp_path / "ro"), "--no-progress"]
+    assert cli.main(rollout) == 0
+
+    def killed(path, value):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(latentrl.results, "write_json", killed)
+    assert cli.main([*rollout, "--seed", "7"]) == 130
+    assert not (tmp_path / "ro" / "rollout.json").exists()

@@ -183,6 +183,9 @@ def _rollout(args: argparse.Namespace) -> int:
 def _write_rollout(args: argparse.Namespace, path: Path, policy: Any, results: dict[str, dict[str, Any]]) -> None:
     from latentrl.results import environment, write_json, write_npz
 
+    # An earlier rollout's summary goes first: a kill between the two writes leaves no summary
+    # (refused by name) rather than one that describes other episodes than rollout.npz holds.
+    (args.out / "rollout.json").unlink(missing_ok=True)
     write_npz(args.out / "rollout.npz", {f"{kind}_{k}": r[k] for kind, r in results.items()
                                          for k in ("returns", "ends", "reached", "paths")})
     summary = {"policy": str(path.resolve()), "policy_from_out": os.path.relpath(path.resolve(), args.out.resolve()),
