@@ -52,8 +52,8 @@ def too_large(size: int, cap: int, what: str) -> str:
     return f"is {size} bytes, more than the {cap} bytes ({_human(cap)}) {what} may have"
 
 
-def _kind(mode: int) -> str:
-    """What a file that is not a regular file is."""
+def not_regular(mode: int) -> str:
+    """What a file that is not a regular file is (`mode`: its `st_mode`), as a refusal's sentence."""
     kinds = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
              (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
     for test, name in kinds:
@@ -71,7 +71,7 @@ def open_regular(path: str | os.PathLike[str], cap: int, what: str) -> Iterator[
     try:
         info = os.fstat(fd)
         if not stat.S_ISREG(info.st_mode):
-            raise ValueError(_kind(info.st_mode))
+            raise ValueError(not_regular(info.st_mode))
         if info.st_size > cap:
             raise ValueError(too_large(info.st_size, cap, what))
         if hasattr(os, "set_blocking"):

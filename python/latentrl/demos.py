@@ -16,6 +16,7 @@ import codecs
 import csv
 import io
 import json
+import stat
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +25,7 @@ from typing import IO, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from latentrl._files import not_regular
 from latentrl._persistence import PathLike, atomic_write, read_npz
 from latentrl.recorded import KINDS, open_recording, read_frames, recording_kind
 from latentrl.recorded.frames import refuse_radians, renamed
@@ -278,9 +280,10 @@ def load_demos(
 def _load_file(path: Path, expected_joints: Sequence[str] | None, joint_map: Mapping[str, str],
                degrees: bool) -> Demonstrations:
     read, _ = _format(path)
-    size = path.stat().st_size  # a missing file: FileNotFoundError, an OSError
-    if not path.is_file():
-        raise ValueError(f"{path}: is not a regular file (a directory, FIFO or device)")
+    info = path.stat()  # a missing file: FileNotFoundError, an OSError
+    size = info.st_size
+    if not stat.S_ISREG(info.st_mode):
+        raise ValueError(f"{path}: {not_regular(info.st_mode)}")
     if size == 0:
         raise ValueError(f"{path}: empty file")
     if size > MAX_DEMO_FILE_BYTES:
