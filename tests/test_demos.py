@@ -180,7 +180,7 @@ def test_a_csv_that_is_not_utf8_is_refused_naming_its_line(tmp_path):
     position 32", a byte offset; a byte-order mark and CRLF line ends are read as before."""
     text = "a,b\r\n0.1,0.2\r\n0.3,0.4\r\n"
     (tmp_path / "latin1.csv").write_bytes(text.encode() + "0.5,0.6 # café\r\n".encode("latin-1"))
-    with pytest.raises(ValueError, match=r"latin1.csv: line 4: byte 0xe9 is not UTF-8 text; save the file as UTF-8"):
+    with pytest.raises(ValueError, match=r"latin1.csv: is not UTF-8 text \(line 4 has byte 0xe9\); save it as UTF-8"):
         load_demos(tmp_path / "latin1.csv")
     (tmp_path / "bom.csv").write_bytes(b"\xef\xbb\xbf" + text.encode())
     demos = load_demos(tmp_path / "bom.csv")

@@ -152,6 +152,19 @@ def test_open_regular_reads_a_regular_file(tmp_path: Path) -> None:
         read_text(path, 5, "a test file")
 
 
+def test_a_task_file_or_urdf_that_is_not_utf8_is_refused_naming_the_line(tmp_path: Path) -> None:
+    """A Latin-1 byte (an accented comment) said "invalid utf-8 sequence of 1 bytes from index
+    61", a byte offset, from the native reader (task file, URDF) and Python's alike."""
+    text = (EXAMPLE / "glass_arm.toml").read_bytes().replace(b'name = "glass_arm"', b'name = "gl\xe4ss_arm"')
+    (tmp_path / "task.toml").write_bytes(text)
+    line = text[:text.index(b"\xe4")].count(b"\n") + 1
+    says = f"is not UTF-8 text \\(line {line} has byte 0xe4\\); save it as UTF-8"
+    with pytest.raises(ValueError, match=f"task.toml: {says}"):
+        Task.load(tmp_path / "task.toml")
+    with pytest.raises(ValueError, match=f"^{says}$"):
+        read_text(tmp_path / "task.toml", 1 << 20, "a task file")
+
+
 BOMB = """<?xml version="1.0"?><COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
 <library_geometries><geometry id="g"><mesh><source id="p"><float_array id="a" count="COUNT">0 0 0 1 0 0 0 1 0 0 0 1</float_array>
 <technique_common><accessor source="#a" count="4" stride="3"><param name="X" type="float"/><param name="Y" type="float"/>

@@ -95,12 +95,14 @@ def read_bounded(path: str | os.PathLike[str], cap: int, what: str) -> bytes:
 
 
 def read_text(path: str | os.PathLike[str], cap: int, what: str) -> str:
-    """`read_bounded` as UTF-8 text (a ValueError if it is not)."""
+    """`read_bounded` as UTF-8 text (a ValueError naming the line and byte if it is not, as the
+    Rust helper)."""
     data = read_bounded(path, cap, what)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
-        raise ValueError(f"is not UTF-8 text: {err}") from None
+        line = data.count(b"\n", 0, err.start) + 1
+        raise ValueError(f"is not UTF-8 text (line {line} has byte {data[err.start]:#04x}); save it as UTF-8") from None
 
 
 def absolute(path: str | os.PathLike[str], what: str) -> Path:

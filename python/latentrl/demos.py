@@ -119,7 +119,7 @@ def _read_csv(path: Path) -> Demonstrations:
         text = data.decode("utf-8")
     except UnicodeDecodeError as err:  # Latin-1 from a spreadsheet: say which line, not which byte
         line = data.count(b"\n", 0, err.start) + 1
-        raise ValueError(f"line {line}: byte {data[err.start]:#04x} is not UTF-8 text; save the file as UTF-8 (a "
+        raise ValueError(f"is not UTF-8 text (line {line} has byte {data[err.start]:#04x}); save it as UTF-8 (a "
                          "spreadsheet's 'CSV UTF-8')") from None
     reader = csv.reader(io.StringIO(text, newline=""))
     lines = [(reader.line_num, row) for row in reader if row]

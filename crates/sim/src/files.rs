@@ -105,9 +105,17 @@ pub fn read_bounded(path: &Path, cap: u64, what: &str) -> Result<Vec<u8>, String
     read_opened(file, &meta, cap, what)
 }
 
-/// [`read_bounded`] as UTF-8 text.
+/// [`read_bounded`] as UTF-8 text; the refusal names the line and byte that are not (a Latin-1
+/// comment), as an editor shows them, not a byte offset.
 pub fn read_text(path: &Path, cap: u64, what: &str) -> Result<String, String> {
-    String::from_utf8(read_bounded(path, cap, what)?).map_err(|e| format!("is not UTF-8 text: {}", e.utf8_error()))
+    String::from_utf8(read_bounded(path, cap, what)?).map_err(|e| {
+        let (bytes, at) = (e.as_bytes(), e.utf8_error().valid_up_to());
+        let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        format!(
+            "is not UTF-8 text (line {line} has byte {:#04x}); save it as UTF-8",
+            bytes[at]
+        )
+    })
 }
 
 #[cfg(test)]
@@ -152,6 +160,17 @@ mod tests {
         assert_eq!(human(1 << 20), "1 MiB");
         assert_eq!(human(128 << 20), "128 MiB");
         assert_eq!(human(1000), "1000 bytes");
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+
+    #[test]
+    fn a_file_that_is_not_utf8_is_refused_naming_its_line_and_byte() {
+        // A URDF with a Latin-1 comment said "invalid utf-8 sequence of 1 bytes from index 61".
+        let dir = scratch("latin1");
+        let path = dir.join("robot.urdf");
+        std::fs::write(&path, b"<?xml version=\"1.0\"?>\n<!-- Bras articul\xe9 -->\n<robot/>\n").unwrap();
+        let err = read_text(&path, 1 << 20, "a URDF").unwrap_err();
+        assert_eq!(err, "is not UTF-8 text (line 2 has byte 0xe9); save it as UTF-8");
         std::fs::remove_dir_all(dir).unwrap();
     }
 }
