@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from latentrl import GPLVM, Task, load_demos
-from latentrl.check import check
+from latentrl.check import check, check_task
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "glass_arm"
@@ -272,3 +272,19 @@ def test_a_coarsened_grid_still_measures_the_target_region_at_the_learner_step(g
     assert 0.8 * full["region_points"] <= coarse["region_points"] <= full["region_points"]
     assert coarse["closest"]["distance"] == pytest.approx(full["closest"]["distance"], abs=1e-3)
     assert np.isfinite(coarse["closest"]["point"]).all() and len(coarse["closest"]["effectors"]) == 3
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize("step", [1e-6, 1e-300])
+def test_a_learner_step_too_small_to_survey_is_refused_naming_it(glass, step):
+    """`latentrl check --learner.step 1e-6` ran for hours and ignored Ctrl-C (each of the grid's
+    moves spanned ~10⁵ learner steps through the physics); 1e-300 overflowed the grid to 0 × 0
+    and said "will not learn: no point … decodes to an admissible posture" with NumPy's "Mean of
+    empty slice" warning."""
+    from latentrl.run_settings import latent_box
+
+    task, demos, model = glass
+    low, high = latent_box(model.Z_, 0.1)
+    with pytest.raises(ValueError, match=r"learner.step = 1e-(6|300): the latent box is \S+ learner steps wide, more "
+                                         r"than a survey samples .*; give a larger learner.step"):
+        check_task(task.replace({"learner.step": step}), demos, model, low, high)

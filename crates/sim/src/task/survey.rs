@@ -37,6 +37,11 @@ pub const DEFAULT_MAX_POINTS: usize = 20_000;
 /// Points classified between two looks at the cancel flag.
 const CHUNK: usize = 64;
 
+/// The most learner steps one grid move may span. A smaller learner step is refused: the
+/// physics of each move and the cells looked into grow with the steps a move spans (a step of
+/// 10⁻⁶ spacings ran for hours, its cells would not fit in memory, 10⁻³⁰⁰ overflowed the grid).
+pub const MAX_STRIDE: usize = 64;
+
 /// Cells looked into again at the learner's step besides the demos': the admissible points
 /// closest to the target.
 const REFINED_CLOSEST: usize = 16;
@@ -58,11 +63,12 @@ impl LatentGrid {
             low.iter()
                 .zip(high)
                 .zip(step)
-                .map(|((lo, hi), s)| ((hi - lo) / (stride as f64 * s) + 1e-9).floor() as usize + 1)
+                .map(|((lo, hi), s)| (((hi - lo) / (stride as f64 * s) + 1e-9).floor() as usize).saturating_add(1))
                 .collect()
         };
+        let points = |shape: Vec<usize>| shape.iter().fold(1usize, |n, &k| n.saturating_mul(k));
         let mut stride = 1;
-        while stride < usize::MAX / 2 && shape_at(stride).iter().product::<usize>() > max_points.max(1) {
+        while stride < usize::MAX / 2 && points(shape_at(stride)) > max_points.max(1) {
             stride += 1;
         }
         Self {
@@ -297,6 +303,19 @@ impl LearnerGrid {
         let step: Vec<f64> = (0..d)
             .map(|k| displacements.chunks_exact(d).map(|m| m[k].abs()).fold(0.0, f64::max))
             .collect();
+        let fits = |k: usize| (high[k] - low[k]) / (MAX_STRIDE as f64 * step[k]) + 1.0;
+        if (0..d).map(fits).product::<f64>() > max_points.max(1) as f64 {
+            let steps = (0..d).map(|k| (high[k] - low[k]) / step[k]).fold(0.0, f64::max);
+            return Err(task_error(
+                task,
+                format!(
+                    "learner.step = {:e}: the latent box is {steps:.3e} learner steps wide, more than a survey \
+                     samples ({max_points} points at most {MAX_STRIDE} learner steps apart); give a larger \
+                     learner.step",
+                    task.config().learner.step
+                ),
+            ));
+        }
         let moves = displacements
             .chunks_exact(d)
             .map(|m| {
@@ -403,6 +422,9 @@ fn survey(
                 let end = (start + CHUNK).min(n);
                 let mut part = Part::default();
                 for i in start..end {
+                    if physics && cancel.load(Ordering::Relaxed) {
+                        return Err(task_error(task, "the survey was cancelled".to_string()));
+                    }
                     grid.point(i, &mut z);
                     decoder.mean_into(&z, &mut q, &mut scratch);
                     let code = plant.reset(&q).map_or(0, |r| r.code());
