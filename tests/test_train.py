@@ -299,3 +299,12 @@ def test_obstacle_advice_does_not_repeat_what_the_run_already_did() -> None:
     assert "move_correction = true" in str(end_advice("obstacle", {"move_correction": False}))
     assert "move_correction" not in str(end_advice("obstacle", {"move_correction": True}))
     assert end_advice("timeout", {"move_correction": False}) is None
+
+
+def test_a_latent_margin_that_overflows_the_box_is_refused_naming_it():
+    """`--latent-margin 1e308` passed the margin's rule (finite, ≥ 0), then failed naming only
+    "latent_low contains a non-finite value (-inf)"."""
+    latent = np.array([[0.0, -1.0], [2.0, 1.0]])
+    assert [b.tolist() for b in latent_box(latent, 0.5)] == [[-1.0, -2.0], [3.0, 2.0]]
+    with pytest.raises(ValueError, match=r"run.latent_margin = 1e\+308 widens the latent box beyond the largest float"):
+        latent_box(latent, 1e308)

@@ -32,10 +32,17 @@ def check_run_fields(preset: Any, names: tuple[str, ...]) -> None:
 
 
 def latent_box(latent: np.ndarray, margin: float) -> tuple[np.ndarray, np.ndarray]:
-    """The bounding box of the latent points, widened by `margin` of its width per side."""
+    """The bounding box of the latent points, widened by `margin` of its width per side; a
+    ValueError naming the margin if that box overflows (1e308: the run failed naming only
+    `latent_low` holding -inf)."""
     low, high = latent.min(axis=0), latent.max(axis=0)
-    pad = margin * (high - low)
-    return low - pad, high + pad
+    with np.errstate(over="ignore", invalid="ignore"):
+        pad = margin * (high - low)
+        box = low - pad, high + pad
+    if np.isfinite(latent).all() and not (np.isfinite(box[0]).all() and np.isfinite(box[1]).all()):
+        raise ValueError(f"run.latent_margin = {margin:g} widens the latent box beyond the largest float; a margin "
+                         "is a share of the box's width per side (ours: 0.1)")
+    return box
 
 
 def check_ints(preset: Any, names: tuple[str, ...], minimum: int = 1) -> None:
