@@ -265,3 +265,17 @@ def test_a_cache_folder_others_may_write_warns_and_is_not_used(tmp_path: Path, m
     assert list((cache / "hulls").iterdir()) == []
     result = cli("urdf-info", str(urdf))
     assert result.returncode == 0 and "writable by other users (mode 777)" in result.stdout + result.stderr
+
+
+@pytest.mark.parametrize("link", ["dangling", "loop"])
+def test_an_out_folder_that_is_a_broken_symlink_is_refused_before_any_work(
+        tmp_path: Path, link: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """`train --out` a dangling symlink or a loop of them fitted the GPLVM and derived the
+    settings, then failed with "[Errno 17] File exists"."""
+    from latentrl import cli
+
+    out = tmp_path / "out"
+    out.symlink_to(tmp_path / ("missing" if link == "dangling" else "out"))
+    missing = str(tmp_path / "no-demos.csv")  # the --out check comes first: the demos are never read
+    assert cli.main(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", missing, "--out", str(out)]) == 1
+    assert f"--out {out}: is a symbolic link to nothing" in capsys.readouterr().err

@@ -21,6 +21,8 @@ def _check_writable(out: Path, *, file: bool) -> None:
     fit or trial, so a typo costs nothing."""
     if out.exists() and out.is_dir() == file:
         raise ValueError(f"--out {out}: is {'a directory' if file else 'a file'}, expected {'a file' if file else 'a directory'}")
+    if not file and out.is_symlink() and not out.exists():  # no folder can be made there (File exists, after the work)
+        raise ValueError(f"--out {out}: is a symbolic link to nothing (its target is missing, or the links loop)")
     parent = (out.parent if file else out).absolute()
     while not parent.exists():
         parent = parent.parent
