@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from latentrl import GPLVM, PCA, LatentPolicy, Task, _reference
+from latentrl import GPLVM, PCA, LatentPolicy, Task, _native, _reference
 from latentrl.cli import build_parser
 from latentrl.cli_commands import _training_run
 from latentrl.datasets import arm_postures
@@ -126,6 +126,10 @@ def test_a_saved_policy_loads_acts_and_rolls_out_the_same(arms_model: GPLVM, tmp
     assert drawn[0]["returns"].shape == (2, 4) and not np.array_equal(drawn[0]["returns"], once["returns"])
     assert drawn[0]["paths"].shape[:2] == once["paths"].shape[:2] == (2, 4)
     assert not np.array_equal(drawn[0]["returns"], drawn[2]["returns"])
+    # Every trial in one run, side by side, is each trial run alone (its own weights and seeds).
+    alone = [loaded.rollout(4, seed=2, trial=t) for t in (0, 1)]
+    for key in ("returns", "ends", "reached", "paths"):
+        np.testing.assert_array_equal(once[key], np.concatenate([a[key] for a in alone]))
     # The greedy step: act() moves the encoded posture by one action and decodes it.
     target = policy.act(posture)
     assert target.shape == (4,) and np.isfinite(target).all()
@@ -154,6 +158,16 @@ def test_rollouts_start_where_the_tests_start_and_share_their_starts(arms_model:
         policy.rollout(1, policy="best")
     with pytest.raises(ValueError, match="starts must be 'test' or 'train'"):
         policy.rollout(1, starts="demo")
+
+
+def test_a_rollout_takes_one_row_of_weights_or_one_per_trial(arms_model: GPLVM) -> None:
+    policy = train_latent_policy(arms_model, trials=2, episodes=2, overrides={"episode.max_steps": 5}, test_episodes=0)
+    run = dict(decoder=arms_model.decoder_, encoder=arms_model.loop_encoder_, latent_low=policy.latent_low,
+               latent_high=policy.latent_high, n_trials=2, episodes=2, base_seed=0, rollout="greedy")
+    with pytest.raises(_native.InvalidInputError, match=r"weights: expected shape one row, or one per trial \(2\), got 3 rows"):
+        _native.run_task_trials(policy.task._native, weights=np.vstack([policy.weights] * 2)[:3], **run)
+    with pytest.raises(_native.InvalidInputError, match=r"weights: expected a float64 array of shape \(M,\) or \(K, M\)"):
+        _native.run_task_trials(policy.task._native, weights=np.zeros((1, 2, 3)), **run)
 
 
 def test_a_policy_file_is_checked(arms_model: GPLVM, tmp_path: Path) -> None:

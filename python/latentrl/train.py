@@ -133,19 +133,17 @@ class LatentPolicy:
             raise ValueError(f"policy must be one of {list(POLICIES)}, got {policy!r}")
         if starts not in ("test", "train"):
             raise ValueError(f"starts must be 'test' or 'train', got {starts!r}")
-        trials = range(len(self.weights)) if trial is None else [self._check_trial(trial)]
-        recorded = list(range(min(episodes, 20)))
-        runs = [
-            _native.run_task_trials(
-                self.task._native, decoder=self.model.decoder_, encoder=self.model.loop_encoder_,
-                latent_low=self.latent_low, latent_high=self.latent_high, demos=self.demos, n_trials=1,
-                episodes=episodes, base_seed=seed, first_trial=t, weights=self.weights[t],
-                rollout=policy, test_starts=starts == "test", record_episodes=recorded, progress=progress,
-            )
-            for t in trials
-        ]
-        result = {key: np.concatenate([r[key] for r in runs]) for key in ("returns", "ends", "reached")}
-        result["paths"] = np.concatenate([r["trajectories"] for r in runs])
+        trials = range(len(self.weights)) if trial is None else range(self._check_trial(trial), trial + 1)
+        run = _native.run_task_trials(  # the trials side by side, each from its own weights
+            self.task._native, decoder=self.model.decoder_, encoder=self.model.loop_encoder_,
+            latent_low=self.latent_low, latent_high=self.latent_high, demos=self.demos, n_trials=len(trials),
+            episodes=episodes, base_seed=seed, first_trial=trials.start,
+            weights=np.ascontiguousarray(np.asarray(self.weights)[trials.start:trials.stop]),
+            rollout=policy, test_starts=starts == "test", record_episodes=list(range(min(episodes, 20))),
+            progress=progress,
+        )
+        result = {key: run[key] for key in ("returns", "ends", "reached")}
+        result["paths"] = run["trajectories"]
         return {"trials": list(trials), **result, "summary": rollout_summary(result["ends"], result["reached"],
                                                                              result["returns"], self.task)}
 

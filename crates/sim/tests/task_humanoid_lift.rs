@@ -198,7 +198,7 @@ fn run(threads: usize, task: &std::sync::Arc<Task>, decoder: &GpMap, encoder: &G
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     let done = AtomicUsize::new(0);
     let demos = common::lift_demos();
-    let trials = TaskTrials::new(task, Some(&demos), &latent, None, options).unwrap();
+    let trials = TaskTrials::new(task, Some(&demos), &latent, &[], options).unwrap();
     let results = pool.install(|| trials.run(&AtomicBool::new(false), &done)).unwrap();
     assert_eq!(done.into_inner(), 2 * 3);
     results
