@@ -166,8 +166,8 @@ def test_a_rollout_takes_one_row_of_weights_or_one_per_trial(arms_model: GPLVM) 
                latent_high=policy.latent_high, n_trials=2, episodes=2, base_seed=0, rollout="greedy")
     with pytest.raises(_native.InvalidInputError, match=r"weights: expected shape one row, or one per trial \(2\), got 3 rows"):
         _native.run_task_trials(policy.task._native, weights=np.vstack([policy.weights] * 2)[:3], **run)
-    with pytest.raises(_native.InvalidInputError, match=r"weights: expected a float64 array of shape \(M,\) or \(K, M\)"):
-        _native.run_task_trials(policy.task._native, weights=np.zeros((1, 2, 3)), **run)
+    with pytest.raises(TypeError, match="weights"):
+        _native.run_task_trials(policy.task._native, weights=np.zeros(400), **run)
 
 
 def test_a_policy_file_is_checked(arms_model: GPLVM, tmp_path: Path) -> None:

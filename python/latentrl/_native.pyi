@@ -486,7 +486,7 @@ def run_task_trials(
 
     decoder: GpMap latent (d) → posture (D); encoder: GpMap or Projection posture → latent.
     latent_low, latent_high: (d,) corners of the latent box. demos: (N, D) demonstrations (a
-    "demo" start uses row `episode.start_demo`). weights: (M,) value weights every trial starts
+    "demo" start uses row `episode.start_demo`). weights: (1, M) value weights every trial starts
     from, or (n_trials, M), one row per trial (a saved policy's; default w₀ everywhere). rollout: run the `episodes` frozen, each action
     "greedy", "softmax" or "random" (the control), each episode from its own generator (the
     same starts for each); test_starts: a rollout starts where the frozen tests do.

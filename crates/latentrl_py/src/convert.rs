@@ -34,18 +34,6 @@ pub fn fixed<const LEN: usize>(name: &str, array: &PyReadonlyArray1<'_, f64>) ->
     })
 }
 
-/// A `(M,)` array as one row, a `(K, M)` array as its K rows, None as no rows.
-pub fn one_or_more_rows(name: &str, array: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<Vec<f64>>> {
-    let Some(array) = array else { return Ok(Vec::new()) };
-    if let Ok(row) = array.extract::<PyReadonlyArray1<'_, f64>>() {
-        return Ok(vec![row.as_array().to_vec()]);
-    }
-    let rows = array
-        .extract::<PyReadonlyArray2<'_, f64>>()
-        .map_err(|_| InvalidInputError::new_err(format!("{name}: expected a float64 array of shape (M,) or (K, M)")))?;
-    Ok(rows.as_array().rows().into_iter().map(|r| r.to_vec()).collect())
-}
-
 /// Rows of a `(N, D)` array of postures, or None.
 pub fn rows(name: &str, array: Option<PyReadonlyArray2<'_, f64>>) -> PyResult<Option<Vec<Vec<f64>>>> {
     array

@@ -11,7 +11,7 @@ use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{config_from, config_to, one_or_more_rows, rows};
+use crate::convert::{config_from, config_to, rows};
 use crate::errors::{guard, sim_to_py, to_py};
 use crate::projection::EncoderObject;
 use crate::runner::{RunArguments, latent_args, named_arrays, run_with_polling};
@@ -132,7 +132,7 @@ pub fn run_task_trials<'py>(
     episodes: &Bound<'py, PyAny>,
     base_seed: &Bound<'py, PyAny>,
     demos: Option<PyReadonlyArray2<'py, f64>>,
-    weights: Option<&Bound<'py, PyAny>>,
+    weights: Option<PyReadonlyArray2<'py, f64>>,
     rollout: Option<&str>,
     test_starts: bool,
     first_trial: Option<&Bound<'py, PyAny>>,
@@ -151,7 +151,7 @@ pub fn run_task_trials<'py>(
         let encoder = EncoderObject::extract("encoder", &encoder)?;
         let args = latent_args(Some(&decoder), Some(&encoder), Some(latent_low), Some(latent_high))?;
         let latent = args.check("").map_err(to_py)?;
-        let (task, weights) = (Arc::clone(&task.inner), one_or_more_rows("weights", weights)?);
+        let (task, weights) = (Arc::clone(&task.inner), rows("weights", weights)?.unwrap_or_default());
         let trials = TaskTrials::new(task, demos.as_deref(), &latent, &weights, options).map_err(sim_to_py)?;
         let total = trials.options.total_episodes();
         let results = run_with_polling(py, total, progress.as_ref(), |c, d| trials.run(c, d).map_err(sim_to_py))?;

@@ -136,7 +136,7 @@ def floor_level_tests(preset: Exp3Preset, weights: NDArray[np.float64], run: Pat
     return _native.run_task_trials(
         task._native, decoder=fitted.model.decoder_, encoder=fitted.model.loop_encoder_, latent_low=fitted.low,
         latent_high=fitted.high, demos=fitted.demos, n_trials=1, episodes=1, base_seed=preset.seed,
-        weights=np.asarray(weights, dtype=np.float64), rollout="greedy", test_episodes=episodes,
+        weights=np.asarray(weights, dtype=np.float64).reshape(1, -1), rollout="greedy", test_episodes=episodes,
         record_test_episodes=list(range(episodes)),
     )
 
