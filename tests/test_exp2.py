@@ -62,7 +62,7 @@ def arms_kwargs(fitted, **overrides):
         ({"latent_low": np.zeros(3)}, r"latent_low: expected shape \(2,\)"),
         ({"latent_high": np.array([1.0, np.nan])}, "non-finite"),
         ({"progress": 1}, "progress: expected a callable"),
-        ({"weights": np.zeros(3)}, r"value weights: expected shape \(400,\), got \(3,\)"),
+        ({"weights": np.zeros((1, 3))}, r"value weights: expected shape \(400,\), got \(3,\)"),
         ({"demos": np.zeros((5, 3))}, "demonstration 0 has 3 values, the robot 4 actuated joints"),
     ],
 )
@@ -116,7 +116,7 @@ def test_records_tests_and_runs_a_task_from_its_dict(fitted):
 def test_a_rollout_is_frozen_and_repeats(fitted, policy):
     trained = run_task_trials(arms()._native, **arms_kwargs(fitted, return_weights=True))
     w = trained["weights"][0]
-    kwargs = arms_kwargs(fitted, n_trials=1, weights=w, rollout=policy, return_weights=True)
+    kwargs = arms_kwargs(fitted, n_trials=1, weights=w[None], rollout=policy, return_weights=True)
     once, again = run_task_trials(arms()._native, **kwargs), run_task_trials(arms()._native, **kwargs)
     np.testing.assert_array_equal(once["weights"][0], w, err_msg="a rollout learns nothing")
     np.testing.assert_array_equal(once["returns"], again["returns"])
