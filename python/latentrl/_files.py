@@ -97,12 +97,18 @@ def read_bounded(path: str | os.PathLike[str], cap: int, what: str) -> bytes:
 def read_text(path: str | os.PathLike[str], cap: int, what: str) -> str:
     """`read_bounded` as UTF-8 text (a ValueError naming the line and byte if it is not, as the
     Rust helper)."""
-    data = read_bounded(path, cap, what)
+    return utf8(read_bounded(path, cap, what))
+
+
+def utf8(data: bytes, how: str = "") -> str:
+    """`data` decoded as UTF-8, or a ValueError naming the line and byte that are not (a Latin-1
+    comment), as an editor shows them; `how`: appended to "save it as UTF-8"."""
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
         line = data.count(b"\n", 0, err.start) + 1
-        raise ValueError(f"is not UTF-8 text (line {line} has byte {data[err.start]:#04x}); save it as UTF-8") from None
+        raise ValueError(f"is not UTF-8 text (line {line} has byte {data[err.start]:#04x}); save it as UTF-8{how}") \
+            from None
 
 
 def absolute(path: str | os.PathLike[str], what: str) -> Path:

@@ -25,7 +25,7 @@ from typing import IO, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from latentrl._files import not_regular
+from latentrl._files import not_regular, utf8
 from latentrl._persistence import PathLike, atomic_write, read_npz
 from latentrl.recorded import KINDS, open_recording, read_frames, recording_kind
 from latentrl.recorded.frames import refuse_radians, renamed
@@ -114,13 +114,7 @@ def _table(rows: Sequence[tuple[str, Sequence[Any]]], names: Sequence[str]) -> N
 
 
 def _read_csv(path: Path) -> Demonstrations:
-    data = path.read_bytes().removeprefix(codecs.BOM_UTF8)
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as err:  # Latin-1 from a spreadsheet: say which line, not which byte
-        line = data.count(b"\n", 0, err.start) + 1
-        raise ValueError(f"is not UTF-8 text (line {line} has byte {data[err.start]:#04x}); save it as UTF-8 (a "
-                         "spreadsheet's 'CSV UTF-8')") from None
+    text = utf8(path.read_bytes().removeprefix(codecs.BOM_UTF8), " (a spreadsheet's 'CSV UTF-8')")
     reader = csv.reader(io.StringIO(text, newline=""))
     lines = [(reader.line_num, row) for row in reader if row]
     if not lines:
