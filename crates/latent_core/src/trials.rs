@@ -269,9 +269,11 @@ pub struct TrialResult {
     pub mean_states: Vec<f64>,
 }
 
-/// Runs `options.n_trials` trials in parallel (rayon's current pool). Each trial clones
-/// `template` (weights included, so pre-trained weights carry over), builds its plant with
-/// `make_plant(trial_index)` and runs `options.episodes` episodes in `space`.
+/// Runs `options.n_trials` trials in parallel (rayon's current pool). Each trial clones its
+/// template — the one of `templates` for every trial, or one per trial in order (a saved
+/// policy's trials, each from its own weights) — weights included, so pre-trained weights carry
+/// over; builds its plant with `make_plant(trial_index)` and runs `options.episodes` episodes
+/// in `space`.
 ///
 /// `cancel` is read before every step and start draw: once set, every trial stops and reports
 /// `finished = false`. `done` is incremented after every episode, test episodes included
@@ -279,7 +281,7 @@ pub struct TrialResult {
 /// Inputs are checked once, up front; the only error past that point is
 /// [`CoreError::NoValidStart`].
 pub fn run_trials<P, F>(
-    template: &Learner,
+    templates: &[Learner],
     space: &StateSpace<'_>,
     make_plant: F,
     options: &TrialOptions,
@@ -291,13 +293,29 @@ where
     F: Fn(usize) -> Result<P> + Sync,
 {
     options.validate()?;
+    if templates.len() != 1 && templates.len() != options.n_trials {
+        return Err(CoreError::Shape {
+            what: "weights",
+            expected: format!("one row, or one per trial ({})", options.n_trials),
+            got: format!("{} rows", templates.len()),
+        });
+    }
     let probe = make_plant(options.first_trial)?;
-    template.check_space(space, probe.posture_dim())?;
+    for template in templates {
+        template.check_space(space, probe.posture_dim())?;
+    }
     drop(probe);
+    let template = |trial: usize| {
+        &templates[if templates.len() == 1 {
+            0
+        } else {
+            trial - options.first_trial
+        }]
+    };
     let trials = options.first_trial..options.first_trial + options.n_trials;
     trials
         .into_par_iter()
-        .map(|trial| run_one(template, space, &make_plant, options, trial, cancel, done))
+        .map(|trial| run_one(template(trial), space, &make_plant, options, trial, cancel, done))
         .collect()
 }
 
@@ -665,7 +683,15 @@ mod tests {
             };
             let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
             let plant = |_| Ok(Line { x: 0.0 });
-            let trial = run_trials(&template, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
+            let trial = run_trials(
+                std::slice::from_ref(&template),
+                &StateSpace::Full,
+                plant,
+                &options,
+                &cancel,
+                &done,
+            )
+            .unwrap();
             assert_eq!(template.weights(), &(0..11).map(f64::from).collect::<Vec<_>>()[..]);
             trial.into_iter().next().unwrap().trajectories
         };
@@ -714,7 +740,15 @@ mod tests {
             };
             let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
             let plant = |_| Ok(Line { x: 0.0 });
-            let trial = run_trials(&template, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
+            let trial = run_trials(
+                std::slice::from_ref(&template),
+                &StateSpace::Full,
+                plant,
+                &options,
+                &cancel,
+                &done,
+            )
+            .unwrap();
             assert_eq!(done.load(Ordering::Relaxed), 2003);
             trial.into_iter().next().unwrap()
         };
@@ -802,7 +836,15 @@ mod tests {
                 episodes: 3,
                 ..Default::default()
             };
-            let trial = run_trials(&template, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
+            let trial = run_trials(
+                std::slice::from_ref(&template),
+                &StateSpace::Full,
+                plant,
+                &options,
+                &cancel,
+                &done,
+            )
+            .unwrap();
             let trial = trial.into_iter().next().unwrap();
             assert!(!trial.finished, "refuse = {refuse}");
             assert_eq!(calls.load(Ordering::Relaxed), 10, "refuse = {refuse}");

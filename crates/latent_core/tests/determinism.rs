@@ -76,7 +76,7 @@ fn run_in(threads: usize, options: &TrialOptions, space: &StateSpace<'_>, [low, 
     let results = pool
         .install(|| {
             run_trials(
-                &learner,
+                std::slice::from_ref(&learner),
                 space,
                 |_| Ok(Line { x: 0.0 }),
                 options,

@@ -288,7 +288,7 @@ pub fn run_bimanual_trials(
 ) -> Result<Vec<TrialResult>> {
     let (template, space) = learner.build(plant, config)?;
     run_trials(
-        &template,
+        std::slice::from_ref(&template),
         &space,
         |_| BimanualPlant::new(plant.clone()),
         options,
