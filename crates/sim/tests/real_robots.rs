@@ -218,6 +218,11 @@ fn arm_with_mesh(test: &str, name: &str, bytes: &[u8]) -> PathBuf {
     urdf
 }
 
+/// Removes the scratch folder of an [`arm_with_mesh`] copy.
+fn remove_copy(urdf: &Path) {
+    std::fs::remove_dir_all(urdf.ancestors().nth(3).unwrap()).unwrap();
+}
+
 fn mesh_error(urdf: &Path) -> (String, String, String) {
     match UrdfModel::from_file_with_cache(urdf, None) {
         Err(SimError::Mesh { link, path, reason, .. }) => (link, path, reason),
@@ -266,6 +271,7 @@ fn bad_meshes_are_refused_naming_link_and_file() {
         assert_eq!(link, "link3", "{test}");
         assert!(path.ends_with(name), "{test}: {path}");
         assert!(reason.contains(says), "{test}: {reason}");
+        remove_copy(&urdf);
     }
 }
 
@@ -278,6 +284,7 @@ fn a_mesh_with_too_many_triangles_is_refused() {
         reason.contains(&format!("{} triangles", MAX_MESH_TRIANGLES + 1)),
         "{reason}"
     );
+    remove_copy(&urdf);
 }
 
 #[test]
@@ -290,6 +297,7 @@ fn missing_meshes_and_escaping_paths_are_refused() {
         path.ends_with("meshes/collision/link3.stl") && reason.contains("cannot read"),
         "{path}: {reason}"
     );
+    remove_copy(&urdf);
 
     let text = std::fs::read_to_string(arm7_path()).unwrap();
     let device = text.replace("package://arm7_description/meshes/collision/link3.stl", "/dev/zero");
