@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 import signal
 import time
@@ -15,6 +16,7 @@ from latentrl.cli_commands import _training_run
 from latentrl.datasets import arm_postures
 from latentrl import train_latent_policy
 from latentrl.run_settings import latent_box
+from latentrl.task import task_digest
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 
@@ -184,6 +186,15 @@ def test_a_policy_file_is_checked(arms_model: GPLVM, tmp_path: Path) -> None:
     np.savez(tmp_path / "edited.npz", **arrays)
     with pytest.raises(ValueError, match="its task .* changed since it was saved"):
         LatentPolicy.load(tmp_path / "edited.npz")
+    # Saved before the schema had learner.move_correction: loads with the key at its default.
+    older = json.loads(str(arrays["task"]))
+    del older["learner"]["move_correction"]
+    np.savez(tmp_path / "older.npz", **{**arrays, "task": np.array(json.dumps(older)),
+                                        "task_digest": np.array(task_digest(older, policy.task.urdf_path))})
+    assert LatentPolicy.load(tmp_path / "older.npz").task.to_dict()["learner"]["move_correction"] is False
+    np.savez(tmp_path / "older_digest.npz", **{**arrays, "task": np.array(json.dumps(older))})
+    with pytest.raises(ValueError, match="its task .* changed since it was saved"):
+        LatentPolicy.load(tmp_path / "older_digest.npz")
     # Issue #38: a newer format, weights or a record of the wrong shape, NaN demos: refused, naming the file.
     edits = {"format_version": np.array(99), "weights": arrays["weights"][..., :3],
              "demos": np.full_like(arrays["demos"], np.nan), "record.returns": arrays["record.returns"].ravel()}

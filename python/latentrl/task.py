@@ -150,16 +150,7 @@ class Task:
         """SHA-256 of the effective configuration but `[run]` (how long a run was, not what it
         ran on) and the URDF's text: what a saved policy records, so that it is not run on
         another task."""
-        config = self.to_dict()
-        del config["run"]
-        text = json.dumps(config, sort_keys=True, allow_nan=True)
-        try:
-            urdf = read_bounded(self.urdf_path, MAX_URDF_BYTES, "a URDF")
-        except ValueError as err:
-            raise ValueError(f"{self.urdf_path}: {err}") from None
-        import hashlib  # OpenSSL: loaded by the first digest, not by `import latentrl`
-
-        return hashlib.sha256(text.encode() + b"\0" + urdf).hexdigest()
+        return task_digest(self.to_dict(), self.urdf_path)
 
     def plant(self, demos: NDArray[np.float64] | None = None) -> _native.TaskPlant:
         """The native plant of this task (home posture: demo `episode.start_demo` of `demos`)."""
@@ -281,3 +272,15 @@ class Task:
     def __repr__(self) -> str:
         return f"Task({self.name!r}, {self.origin!r}, {len(self.joint_names)} joints, effectors {list(self.effectors)})"
 
+
+def task_digest(config: Mapping[str, Any], urdf_path: Path) -> str:
+    """`Task.digest` of the task keys `config` (`Task.to_dict()`, `[run]` left out) and the URDF
+    at `urdf_path`; a saved policy's recorded keys give the digest it was saved with."""
+    text = json.dumps({k: v for k, v in config.items() if k != "run"}, sort_keys=True, allow_nan=True)
+    try:
+        urdf = read_bounded(urdf_path, MAX_URDF_BYTES, "a URDF")
+    except ValueError as err:
+        raise ValueError(f"{urdf_path}: {err}") from None
+    import hashlib  # OpenSSL: loaded by the first digest, not by `import latentrl`
+
+    return hashlib.sha256(text.encode() + b"\0" + urdf).hexdigest()

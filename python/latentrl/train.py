@@ -26,7 +26,7 @@ from latentrl._persistence import FORMAT_VERSION, PathLike, atomic_write, check_
 from latentrl.episode_ends import end_reasons
 from latentrl.gplvm import GPLVM
 from latentrl.rollout_summary import format_rollout, rollout_summary
-from latentrl.task import Task
+from latentrl.task import Task, task_digest
 
 __all__ = ["POLICIES", "RECORD", "LatentPolicy", "format_rollout", "rollout_summary"]
 
@@ -181,8 +181,9 @@ class LatentPolicy:
 
     @classmethod
     def load(cls, path: PathLike) -> LatentPolicy:
-        """Reads a policy written by `save`; its task is rebuilt from the saved keys and folder and
-        must hash as when saved (a changed URDF is refused). Errors are ValueErrors naming the file."""
+        """Reads a policy written by `save`; its task is rebuilt from the saved keys and folder, and
+        those keys and the URDF must hash as when saved (a changed URDF is refused; a key added to
+        latentrl since takes its default). Errors are ValueErrors naming the file."""
         try:
             arrays = read_npz(path)
         except ValueError as err:
@@ -202,7 +203,9 @@ class LatentPolicy:
             task = Task.from_dict(keys, Path(str(arrays["task_dir"])), f"the task of {path}")
         except TypeError as err:  # a key of the wrong type: the file is damaged, not the call
             raise ValueError(str(err)) from None
-        if task.digest() != str(arrays["task_digest"]):
+        # Keys added to the schema since the save are at their defaults, the behaviour before they
+        # existed (`task_schema.ran_with`): the recorded keys and the URDF must still give the digest.
+        if task_digest(keys, task.urdf_path) != str(arrays["task_digest"]):
             raise ValueError(f"{path}: its task (or the task's URDF in {arrays['task_dir']}) changed since it was saved")
         model = GPLVM._from_arrays({k[6:]: v for k, v in arrays.items() if k.startswith("model.")}, str(path))
         record = {k[7:]: v for k, v in arrays.items() if k.startswith("record.")}
