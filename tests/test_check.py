@@ -288,3 +288,14 @@ def test_a_learner_step_too_small_to_survey_is_refused_naming_it(glass, step):
     with pytest.raises(ValueError, match=r"learner.step = 1e-(6|300): the latent box is \S+ learner steps wide, more "
                                          r"than a survey samples .*; give a larger learner.step"):
         check_task(task.replace({"learner.step": step}), demos, model, low, high)
+
+
+def test_train_refuses_a_given_step_too_small_to_survey_before_it_trains(tmp_path):
+    """`train --learner.step 1e-6` with `episode.max_steps` given (no survey to derive it) trained,
+    then its report refused the step: now refused after the fit, before training, naming it."""
+    out = tmp_path / "run"
+    proc = latentrl("train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--out", str(out),
+                    "--quick", "--learner.step", "1e-6", "--no-progress")
+    assert proc.returncode == 1, proc.stdout + proc.stderr
+    assert "learner.step = 1e-6: the latent box is" in proc.stderr and "Traceback" not in proc.stderr
+    assert not (out / "returns.npz").exists() and not (out / "policy.npz").exists()
