@@ -17,6 +17,7 @@ import pytest
 
 from latentrl import Demonstrations, Task, cli, load_demos, save_demos
 from latentrl.recorded import frames as frames_module
+from latentrl.recorded.options import joint_map
 from latentrl.recorded.sampling import farthest_points
 
 from recorded_writers import NAMES, episodes_of, write_bag, write_episode, write_hdf5, write_lerobot
@@ -93,6 +94,29 @@ def test_a_joint_map_renames_the_columns_of_a_csv_too(tmp_path):
     assert load_demos(tmp_path / "d.csv", joint_map={"a": "x"}, expected_joints=["b", "x"]).joint_names == ("b", "x")
     with pytest.raises(ValueError, match=r"d.csv: a file of postures names its joints; key and joint names"):
         load_demos(tmp_path / "d.csv", key="observation.state")
+
+
+def test_a_joint_map_leaves_out_the_columns_it_maps_to_nothing(tmp_path):
+    """A recorder's CSV with a time stamp and a gripper: `--joint-map time=,gripper=` keeps the
+    joints; in a recording (fit, no task) the column is left out too."""
+    values = np.arange(12.0).reshape(3, 4)
+    save_demos(Demonstrations(values, ("time", "b", "gripper", "a")), tmp_path / "d.csv")
+    drop = joint_map("time=, gripper=")
+    assert drop == {"time": "", "gripper": ""}
+    demos = load_demos(tmp_path / "d.csv", joint_map=drop, expected_joints=["a", "b"])
+    assert demos.joint_names == ("a", "b")
+    np.testing.assert_array_equal(demos.postures, values[:, [3, 1]])
+    assert load_demos(tmp_path / "d.csv", joint_map={"time": "", "a": "x"}).joint_names == ("b", "gripper", "x")
+    with pytest.raises(ValueError, match=r"d.csv: joint names do not match the expected ones: missing \[\], "
+                                         r"unknown \['time', 'gripper'\]"):
+        load_demos(tmp_path / "d.csv", expected_joints=["a", "b"])
+    with pytest.raises(ValueError, match=r"the joint map renames \['stamp'\], which are not among the joints"):
+        load_demos(tmp_path / "d.csv", joint_map={"stamp": ""})
+    episodes = episodes_of(width=4)
+    write_lerobot(tmp_path / "ds", episodes, ["shoulder", "elbow", "gripper", "wrist"], value_type=pa.float64())
+    demos = load_demos(tmp_path / "ds", joint_map={"gripper": ""})
+    assert demos.joint_names == ("shoulder", "elbow", "wrist")
+    np.testing.assert_array_equal(demos.postures, np.concatenate(episodes)[:, [0, 1, 3]])
 
 
 def test_degrees_are_refused_and_converted_on_request(tmp_path):
@@ -324,7 +348,7 @@ def test_cli_errors_are_one_line_naming_file_and_field(tmp_path, capsys):
     assert err.startswith("latentrl: error: ") and "Traceback" not in err and err.count("\n") == 1
     assert "data/demo_2/obs/robot0_joint_pos: episode 2, frame 1, joint 'shoulder': nan" in err
     assert cli.main(["fit", str(path), "--joint-map", "shoulder", "--out", str(tmp_path / "m.npz")]) == 1
-    assert "joint_map: expected old=new[,old=new…], got 'shoulder'" in capsys.readouterr().err
+    assert "joint_map: expected old=new[,old=new…] (old= leaves a column out), got 'shoulder'" in capsys.readouterr().err
 
 
 def test_cli_fit_reads_a_recording_with_its_flags(tmp_path, capsys):

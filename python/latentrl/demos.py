@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from latentrl._files import not_regular, utf8
 from latentrl._persistence import PathLike, atomic_write, read_npz
 from latentrl.recorded import KINDS, open_recording, read_frames, recording_kind
-from latentrl.recorded.frames import refuse_radians, renamed
+from latentrl.recorded.frames import kept_columns, refuse_radians, renamed
 from latentrl.recorded.sampling import farthest_points
 
 
@@ -228,7 +228,8 @@ def load_demos(
     LeRobot dataset folder, robomimic HDF5 (``.hdf5``, ``.h5``), a ROS 1 bag (``.bag``) or a ROS 2
     bag folder (docs/demos.md; each needs its extra: `latentrl.recorded`).
 
-    `joint_map` renames joints (old → new) before they are matched. With `expected_joints`, a
+    `joint_map` renames joints (old → new) before they are matched; a joint mapped to ``""`` is
+    left out (a time stamp, a gripper: ``{"time": ""}``). With `expected_joints`, a
     file of postures must name exactly those joints; a recording must have them and its other
     joints (a gripper, a wheel) are dropped; the columns are returned in that order. `degrees`:
     the values are degrees, converted to radians (a recording's kept joint beyond ±2π is refused
@@ -286,7 +287,9 @@ def _load_file(path: Path, expected_joints: Sequence[str] | None, joint_map: Map
     try:
         demos = read(path)
         if joint_map:
-            demos = Demonstrations(demos.postures, renamed(demos.joint_names, joint_map), demos.episodes, demos.frames)
+            names = renamed(demos.joint_names, joint_map)
+            kept = kept_columns(names, None, str(path))
+            demos = Demonstrations(demos.postures[:, kept], tuple(names[c] for c in kept), demos.episodes, demos.frames)
         if expected_joints is not None:
             demos = _select(demos, tuple(expected_joints))
     except (ValueError, csv.Error) as err:

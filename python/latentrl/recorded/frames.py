@@ -83,23 +83,25 @@ class Frames:
 
 
 def renamed(names: Sequence[str], joint_map: Mapping[str, str]) -> tuple[str, ...]:
-    """`names` with `joint_map`'s renames (old → new); a name to rename that is not there, or two
-    joints that end up with one name, is a ValueError."""
+    """`names` with `joint_map`'s renames (old → new; new "": the column is left out, its name
+    ""); a name to rename that is not there, or two joints that end up with one name, is a
+    ValueError."""
     absent = sorted(set(joint_map) - set(names))
     if absent:
         raise ValueError(f"the joint map renames {absent}, which are not among the joints {list(names)}")
     new = tuple(joint_map.get(name, name) for name in names)
-    twice = sorted({name for name in new if new.count(name) > 1})
+    twice = sorted({name for name in new if name and new.count(name) > 1})
     if twice:
         raise ValueError(f"after the joint map, joints {twice} name two columns each")
     return new
 
 
 def kept_columns(names: tuple[str, ...], expected: Sequence[str] | None, where: str) -> list[int]:
-    """Columns of `expected` in `names`, in `expected`'s order (all of them without it): joints
-    the recording has beyond them are dropped, one it lacks is a ValueError naming it."""
+    """Columns of `expected` in `names`, in `expected`'s order (without it, all but those a joint
+    map left out, named ""): joints the recording has beyond them are dropped, one it lacks is a
+    ValueError naming it."""
     if expected is None:
-        return list(range(len(names)))
+        return [c for c, name in enumerate(names) if name]
     missing = [name for name in expected if name not in names]
     if missing:
         raise ValueError(f"{where}: joints {missing} are not in the recording, which has {list(names)} "

@@ -8,12 +8,14 @@ from typing import Any
 
 
 def joint_map(text: str) -> dict[str, str]:
-    """``old=new,old2=new2`` → {old: new, old2: new2}; a malformed entry is a ValueError."""
+    """``old=new,old2=new2,time=`` → {old: new, old2: new2, time: ""} (``old=``: the column is
+    left out); a malformed entry is a ValueError."""
     renames: dict[str, str] = {}
     for entry in filter(None, (e.strip() for e in text.split(","))):
         old, eq, new = (part.strip() for part in entry.partition("="))
-        if not eq or not old or not new:
-            raise ValueError(f"joint_map: expected old=new[,old=new…], got {entry!r} in {text!r}")
+        if not eq or not old:
+            raise ValueError(f"joint_map: expected old=new[,old=new…] (old= leaves a column out), got {entry!r} "
+                             f"in {text!r}")
         if old in renames:
             raise ValueError(f"joint_map: {old!r} is renamed twice in {text!r}")
         renames[old] = new
@@ -29,7 +31,7 @@ class DemoOptions:
     joint_names: str = ""
     """The joint names of a recording that names none, comma-separated (an HDF5 file without a joint_names attribute, a LeRobot feature without names)."""
     joint_map: str = ""
-    """Renames of the demonstrations' joints before they are matched to the robot's, old=new[,old=new…]."""
+    """Renames of the demonstrations' joints before they are matched to the robot's, old=new[,old=new…]; old= (nothing after =) leaves that column out (a time stamp, a gripper)."""
     degrees: bool = False
     """The demonstrations' joint values are degrees: convert them to radians (without it, a recorded joint beyond ±2π is refused as looking like degrees)."""
     max_postures: int = 0
