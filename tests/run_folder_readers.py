@@ -68,7 +68,6 @@ def read_file(root: Path, name: str, *, draw: bool = False) -> None:
     that read it call them; with `draw`, also what `replay` computes from what it read before
     drawing (the latent path, the links' poses: ~0.5 s an episode, in the GP encoder)."""
     from latentrl.saved_runs import saved_run
-    from latentrl.experiments.presets import describe
     from latentrl.experiments.run_folder import RunFolder
     from latentrl.experiments.training import setup
     from latentrl.replay import replay, rollout_episode
@@ -92,7 +91,7 @@ def read_file(root: Path, name: str, *, draw: bool = False) -> None:
     # results.json, returns.npz, gplvm.npz: as `train --resume` reads them (runner.run_rl) …
     folder = RunFolder(out)
     folder.preset(), folder.recorded_task(), folder.recorded_inputs()
-    arrays, meta = folder.previous(describe(run))
+    arrays, meta = folder.previous(run)
     built = setup(run, out)
     if meta is not None:
         folder.check_continued(meta, built.learners, built.info, arrays)

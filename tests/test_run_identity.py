@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from child import CHILD, wait_for
+from latentrl.results import PRESET_KEY
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
 
@@ -249,6 +250,24 @@ def test_an_edited_collision_mesh_is_refused_by_name(tmp_path):
     (tmp_path / "hand.stl").write_bytes(bytes(stl))
     result = latentrl(*args, "--resume")
     assert result.returncode == 1 and "its meshes changed since the run (sha256 " in result.stderr, result.stderr
+
+
+def test_a_run_recorded_before_a_preset_field_existed_resumes_with_its_default(run):
+    """A field added to TrainRun since a run was saved is not "not given in the run": it takes its
+    default there, the behaviour before it existed; a resume that sets it otherwise is refused."""
+    folder, resume = run
+    out = folder / "out"
+    meta = json.loads((out / "results.json").read_text())
+    del meta["preset"]["max_postures"]
+    (out / "results.json").write_text(json.dumps(meta))
+    arrays = dict(np.load(out / "returns.npz"))
+    preset = json.loads(str(arrays[PRESET_KEY]))
+    del preset["max_postures"]
+    np.savez_compressed(out / "returns.npz", **{**arrays, PRESET_KEY: np.array(json.dumps(preset))})
+    result = latentrl(*resume)
+    assert result.returncode == 0, result.stderr
+    result = latentrl(*resume, "--max-postures", "50")
+    assert result.returncode == 1 and "max_postures: 0 in the run, 50 now" in result.stderr, result.stderr
 
 
 def test_a_preset_of_another_kind_is_named_alone():

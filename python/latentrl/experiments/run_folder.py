@@ -5,6 +5,7 @@ files' layout is `latentrl.results`."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -13,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from latentrl._persistence import read_npz
+from latentrl.experiments.presets import describe
 from latentrl.results import (
     MODEL_FILE,
     PER_EPISODE,
@@ -129,8 +131,8 @@ class RunFolder:
             self._model = GPLVM._from_arrays(arrays, str(self.model_path)), arrays
         return self._model
 
-    def previous(self, plan: dict[str, Any]) -> tuple[dict[str, np.ndarray], dict[str, Any] | None]:
-        """Arrays and metadata of an earlier run of the preset `plan` (`describe`) in this folder,
+    def previous(self, preset: Any) -> tuple[dict[str, np.ndarray], dict[str, Any] | None]:
+        """Arrays and metadata of an earlier run of `preset` in this folder,
         ({}, None) if there is none; a ValueError if the folder holds a run of another preset, or
         one whose results.json was edited after its trials ran. Temporary files a killed write
         left are removed first."""
@@ -139,30 +141,31 @@ class RunFolder:
         if not self.results_path.exists():
             return {}, None
         meta = self.results()
-        self.check_preset(plan)
+        self.check_preset(preset)
         if not self.arrays_path.exists():
             return {}, None
         arrays = self.arrays()
         recorded = self.recorded_task()
-        self._check_saved_run(plan, arrays, ran_with(recorded) if recorded is not None else {})
+        self._check_saved_run(preset, arrays, ran_with(recorded) if recorded is not None else {})
         return arrays, meta
 
-    def check_preset(self, plan: dict[str, Any]) -> None:
-        """The run saved here is of the preset `plan` (`describe`); a ValueError naming each field
-        and task key that differs otherwise. Reads results.json only: `train --resume` asks before
-        its fit."""
+    def check_preset(self, preset: Any) -> None:
+        """The run saved here is of `preset`; a ValueError naming each field and task key that
+        differs otherwise (a field the record lacks counts at its default: `with_defaults`). Reads
+        results.json only: `train --resume` asks before its fit."""
         recorded = self.recorded_task()
         ran = ran_with(recorded) if recorded is not None else {}
-        changes = edits(self.preset(), as_saved(plan), ran, "in the run", "now")
+        changes = edits(with_defaults(self.preset(), preset), as_saved(describe(preset)), ran, "in the run", "now")
         if changes:
             raise ValueError(f"{self.path} holds a run of a different preset ({changes}); choose another --out "
                              "or delete it (only a run of the same preset is continued)")
 
-    def _check_saved_run(self, plan: dict[str, Any], arrays: Mapping[str, np.ndarray], ran: Mapping[str, Any]) -> None:
-        """The arrays of a run being continued were computed with `plan`; a ValueError naming the
+    def _check_saved_run(self, preset: Any, arrays: Mapping[str, np.ndarray], ran: Mapping[str, Any]) -> None:
+        """The arrays of a run being continued were computed with `preset`; a ValueError naming the
         edited fields otherwise (mixing would be silently wrong)."""
         if PRESET_KEY in arrays:
-            saved, now = saved_preset(self.arrays_path, arrays[PRESET_KEY]), as_saved(plan)
+            saved = with_defaults(saved_preset(self.arrays_path, arrays[PRESET_KEY]), preset)
+            now = as_saved(describe(preset))
             changes = edits(saved, now, ran, "in returns.npz", "in results.json")
             if changes:
                 raise ValueError(f"{self.path}/results.json was edited after its trials ran ({changes}); resume refuses "
@@ -224,6 +227,18 @@ def saved_preset(path: Path, value: np.ndarray) -> dict[str, Any]:
         raise ValueError(f"{path}: {PRESET_KEY} is not the JSON object of a preset (got {value.dtype} of shape "
                          f"{value.shape}); restore the file, or start a new run with --out")
     return saved
+
+
+def with_defaults(saved: Mapping[str, Any], preset: Any) -> dict[str, Any]:
+    """A preset a run recorded, each field of `preset`'s class that the record lacks at the class's
+    default when the record is of that class: a field added since, the behaviour before it
+    existed (as `task.ran_with` completes the recorded task)."""
+    if saved.get("name") != type(preset).__name__:
+        return dict(saved)
+    fields = dataclasses.fields(preset)
+    defaults = {f.name: f.default for f in fields if f.default is not dataclasses.MISSING}
+    defaults |= {f.name: f.default_factory() for f in fields if f.default_factory is not dataclasses.MISSING}
+    return {**as_saved(defaults), **saved}
 
 
 def edited_fields(saved: Mapping[str, Any], now: Mapping[str, Any], ran: Mapping[str, Any]) -> list[str]:

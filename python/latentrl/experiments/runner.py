@@ -136,7 +136,7 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
     folder = RunFolder(out)
     meta_path, arrays_path = folder.results_path, folder.arrays_path
     plan = describe(preset)
-    arrays, meta = folder.previous(plan)
+    arrays, meta = folder.previous(preset)
     started = time.perf_counter()
     built = setup(preset, out)
     if meta is not None:

@@ -124,12 +124,11 @@ def check_resumable(run: TrainRun, out: Path) -> None:
     """Before the fit: the run saved in `out`, if any, is of `run`'s preset and was made from its
     task file, URDF and demos (their recorded digests); a ValueError naming what differs. The
     model's digest is compared once the run's model is read (`prepared`)."""
-    from latentrl.experiments.presets import describe
     from latentrl.experiments.run_folder import RunFolder
 
     folder = RunFolder(out)
     if folder.results_path.is_file():
-        folder.check_preset(describe(run))
+        folder.check_preset(run)
         folder.check_inputs(input_digests(run.task_file, *_inputs(*_keys(run))))
 
 
