@@ -683,15 +683,8 @@ mod tests {
             };
             let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
             let plant = |_| Ok(Line { x: 0.0 });
-            let trial = run_trials(
-                std::slice::from_ref(&template),
-                &StateSpace::Full,
-                plant,
-                &options,
-                &cancel,
-                &done,
-            )
-            .unwrap();
+            let one = std::slice::from_ref(&template);
+            let trial = run_trials(one, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
             assert_eq!(template.weights(), &(0..11).map(f64::from).collect::<Vec<_>>()[..]);
             trial.into_iter().next().unwrap().trajectories
         };
@@ -740,15 +733,8 @@ mod tests {
             };
             let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
             let plant = |_| Ok(Line { x: 0.0 });
-            let trial = run_trials(
-                std::slice::from_ref(&template),
-                &StateSpace::Full,
-                plant,
-                &options,
-                &cancel,
-                &done,
-            )
-            .unwrap();
+            let one = std::slice::from_ref(&template);
+            let trial = run_trials(one, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
             assert_eq!(done.load(Ordering::Relaxed), 2003);
             trial.into_iter().next().unwrap()
         };
@@ -836,15 +822,8 @@ mod tests {
                 episodes: 3,
                 ..Default::default()
             };
-            let trial = run_trials(
-                std::slice::from_ref(&template),
-                &StateSpace::Full,
-                plant,
-                &options,
-                &cancel,
-                &done,
-            )
-            .unwrap();
+            let one = std::slice::from_ref(&template);
+            let trial = run_trials(one, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
             let trial = trial.into_iter().next().unwrap();
             assert!(!trial.finished, "refuse = {refuse}");
             assert_eq!(calls.load(Ordering::Relaxed), 10, "refuse = {refuse}");
