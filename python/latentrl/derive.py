@@ -103,9 +103,10 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
         out.append(Derived("learner.initial_weight", w0, f"1 / (1 − γ) with γ = {config['learner']['gamma']:g}: "
                                                           "optimistic, the largest return of rewards ≤ 1"))
     step = config["learner"]["step"]
-    # A given step is surveyed as given: one too small to survey the box is refused before training.
-    survey = survey_at_step(task, model, low, high, demos) if "learner.step" in given else None
-    if "learner.step" not in given:
+    survey = None
+    if "learner.step" in given:  # surveyed as given: one too small to survey the box is refused before training
+        survey = survey_at_step(task, model, low, high, demos)
+    else:
         budget = config["episode"]["max_steps"] if "episode.max_steps" in given else _default("episode.max_steps")
 
         def step_on(m: Any) -> tuple[float, dict[str, Any], str, bool] | None:
