@@ -112,10 +112,14 @@ def test_a_joint_map_leaves_out_the_columns_it_maps_to_nothing(tmp_path):
         load_demos(tmp_path / "d.csv", expected_joints=["a", "b"])
     with pytest.raises(ValueError, match=r"the joint map renames \['stamp'\], which are not among the joints"):
         load_demos(tmp_path / "d.csv", joint_map={"stamp": ""})
+    with pytest.raises(ValueError, match=r"d.csv: demo columns: the joint map leaves out every column$"):
+        load_demos(tmp_path / "d.csv", joint_map=dict.fromkeys(("time", "b", "gripper", "a"), ""))
     episodes = episodes_of(width=4)
     write_lerobot(tmp_path / "ds", episodes, ["shoulder", "elbow", "gripper", "wrist"], value_type=pa.float64())
     demos = load_demos(tmp_path / "ds", joint_map={"gripper": ""})
     assert demos.joint_names == ("shoulder", "elbow", "wrist")
+    with pytest.raises(ValueError, match=r"ds \(observation.state\): the joint map leaves out every column$"):
+        load_demos(tmp_path / "ds", joint_map=dict.fromkeys(("shoulder", "elbow", "gripper", "wrist"), ""))
     np.testing.assert_array_equal(demos.postures, np.concatenate(episodes)[:, [0, 1, 3]])
 
 

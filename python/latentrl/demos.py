@@ -288,7 +288,7 @@ def _load_file(path: Path, expected_joints: Sequence[str] | None, joint_map: Map
         demos = read(path)
         if joint_map:
             names = renamed(demos.joint_names, joint_map)
-            kept = kept_columns(names, None, str(path))
+            kept = kept_columns(names, None, "demo columns")
             demos = Demonstrations(demos.postures[:, kept], tuple(names[c] for c in kept), demos.episodes, demos.frames)
         if expected_joints is not None:
             demos = _select(demos, tuple(expected_joints))

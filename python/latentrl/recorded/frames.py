@@ -101,7 +101,10 @@ def kept_columns(names: tuple[str, ...], expected: Sequence[str] | None, where: 
     map left out, named ""): joints the recording has beyond them are dropped, one it lacks is a
     ValueError naming it."""
     if expected is None:
-        return [c for c, name in enumerate(names) if name]
+        kept = [c for c, name in enumerate(names) if name]
+        if not kept:
+            raise ValueError(f"{where}: the joint map leaves out every column")
+        return kept
     missing = [name for name in expected if name not in names]
     if missing:
         raise ValueError(f"{where}: joints {missing} are not in the recording, which has {list(names)} "
