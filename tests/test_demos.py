@@ -1,4 +1,5 @@
 import json
+from unittest.mock import patch
 
 import numpy as np
 import pytest
@@ -6,6 +7,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
+import latentrl.demos
 from latentrl import Demonstrations, load_demos, save_demos
 
 NAMES = ("shoulder_l", "elbow_l", "shoulder_r", "elbow_r")
@@ -65,6 +67,23 @@ def test_csv_with_byte_order_mark_and_spaces(tmp_path):
     loaded = load_demos(path)
     assert loaded.joint_names == ("a", "b")
     np.testing.assert_array_equal(loaded.postures, [[1.0, 2.5]])
+
+
+@given(
+    st.lists(st.lists(st.floats(-1e300, 1e300), min_size=3, max_size=3), min_size=1,
+             max_size=4),
+    st.sampled_from(["{!r}", "{:.3e}", " {:.17g} ", "{:+.1f}\t"]),
+    st.sampled_from(["\n", "\r\n"]),
+    st.sampled_from(["", "\n", "\n\n"]),
+)
+def test_numpy_reads_a_plain_csv_as_the_cell_by_cell_reader(tmp_path_factory, rows, cell, eol, end):
+    path = tmp_path_factory.mktemp("csv") / "d.csv"
+    path.write_bytes((eol.join(["a, b ,c", *(",".join(cell.format(v) for v in row) for row in rows)]) + end).encode())
+    fast = load_demos(path)
+    with patch.object(latentrl.demos, "_numbers_below_header", lambda text: None):
+        cells = load_demos(path)
+    np.testing.assert_array_equal(fast.postures, cells.postures)
+    assert fast.joint_names == cells.joint_names == ("a", "b", "c")
 
 
 def write(tmp_path, name, text):
