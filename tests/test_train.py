@@ -287,18 +287,51 @@ def test_a_trial_that_stopped_improving_stops_and_is_read_as_it_ran(arms_model: 
 
 
 def test_timeouts_are_told_apart_by_their_reward_per_step() -> None:
-    """Issue #37: timed-out episodes earning ≥ ½ per step hover near the target (a smaller step
-    may land); earning less they wander away from it, where a smaller step does not help (the
+    """Issue #37: timed-out episodes earning ≥ ½ per step hover near the target (more episodes
+    helped the zoo's snake, a smaller step did not); earning less they wander away from it (the
     zoo's iiwa arm: its timeouts sat in a band of the latent space far from the demos)."""
     from types import SimpleNamespace
 
     from latentrl.verdict import timeout_advice
 
     policy = SimpleNamespace(task=SimpleNamespace(to_dict=lambda: {"episode": {"max_steps": 200}}))
-    assert "near the target (mean reward 0.60 per step): a smaller learner.step" in timeout_advice(
-        policy, np.array([110.0, 130.0]))
+    near = timeout_advice(policy, np.array([110.0, 130.0]))
+    assert "near the target (mean reward 0.60 per step): the policy hovers" in near
+    assert "--episode.stop-window 0" in near and "smaller learner.step" not in near
     far = timeout_advice(policy, np.array([10.0, 30.0]))
     assert "away from the target (mean reward 0.10 per step)" in far and "smaller learner.step" not in far
+
+
+def test_the_advice_follows_how_the_greedy_rollouts_failed_not_training() -> None:
+    """Issue #37: the zoo's snake failed its training episodes mostly on the wall (the soft-max
+    explores) while its greedy rollouts mostly hovered beside the target; the advice was for the
+    wall. It follows the greedy rollouts that missed, the policy `act()` runs."""
+    from types import SimpleNamespace
+
+    from latentrl.episode_ends import end_reasons
+    from latentrl.rollout_summary import rollout_summary
+    from latentrl.verdict import training_verdict
+
+    names = end_reasons()
+    timeout, obstacle = names.index("timeout"), names.index("obstacle")
+    config = {"episode": {"max_steps": 100}, "learner": {"move_correction": False}, "target": {"hold_steps": 0}}
+    task = SimpleNamespace(to_dict=lambda: config)
+    greedy = {"ends": np.array([[timeout] * 6 + [obstacle] * 2]), "reached": np.array([[True] * 3 + [False] * 5]),
+              "returns": np.full((1, 8), 70.0)}
+
+    def rollout(episodes: int, seed: int, policy: str) -> dict[str, object]:
+        run = greedy if policy == "greedy" else {**greedy, "reached": np.zeros((1, 8), dtype=bool)}
+        return {**run, "summary": rollout_summary(run["ends"].ravel(), run["reached"].ravel(),
+                                                  run["returns"].ravel(), task)}
+
+    training = np.array([[timeout] * 10 + [obstacle] * 40])
+    policy = SimpleNamespace(task=task, rollout=rollout, record={
+        "ends": training, "reached": np.arange(50)[None] < 5, "returns": np.zeros(training.shape)})
+    verdict = training_verdict(policy, episodes=8)  # type: ignore[arg-type]
+    assert verdict.late_ends["obstacle"] == 10 and verdict.late_ends["timeout"] == 0
+    assert len(verdict.next) == 1 and "time out near the target (mean reward 0.70 per step)" in verdict.next[0]
+    greedy["ends"] = np.array([[timeout] * 3 + [obstacle] * 5])
+    assert "most failing greedy rollouts end as obstacle" in training_verdict(policy, episodes=8).next[0]  # type: ignore[arg-type]
 
 
 def test_a_trial_stopped_in_a_dip_below_another_is_told() -> None:

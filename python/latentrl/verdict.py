@@ -12,8 +12,10 @@ such a rule, that comes within the reach radius at some step. One of three verdi
 - **stopped improving below the target**: anything between.
 
 With the verdict come the endings of the last fifth of the training episodes each trial ran, whether the reach
-rate was still rising there (more episodes may help), and the next things to try, taken from the
-endings and from `latentrl check`'s findings.
+rate was still rising there (more episodes may help), and the next things to try, taken from how
+the greedy rollouts that failed ended (the policy `act()` runs, not training's exploring
+soft-max: the zoo's snake failed training episodes mostly on the wall, its greedy rollouts mostly
+by hovering beside the target) and from `latentrl check`'s findings.
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ ADVICE = {
     "box_exit": "a larger --latent-margin: the learner presses against the latent box's edge",
     "variance_gate": "a higher learner.variance_threshold, or none",
 }
-"""The next thing to try when most failing late training episodes end this way."""
+"""The next thing to try when most failing greedy rollouts end this way."""
 
 
 @dataclass(frozen=True)
@@ -79,8 +81,17 @@ def success_share(summary: dict[str, Any]) -> float:
     return float(summary["reached_any_step"] if summary["success"] is None else summary["success"])
 
 
+def succeeded(run: dict[str, Any], summary: dict[str, Any]) -> NDArray[np.bool_]:
+    """Per episode of a rollout `run` (flattened over its trials), whether it succeeded as
+    `success_share` counts: ended as a success, or, without a success rule, reached the target."""
+    if summary["success"] is None:
+        return np.asarray(run["reached"], dtype=bool).ravel()
+    success: NDArray[np.bool_] = np.asarray(run["ends"]).ravel() == end_reasons().index("success")
+    return success
+
+
 def end_advice(worst: str, learner: dict[str, Any]) -> str | None:
-    """`ADVICE` for the ending most failing episodes had, under the `learner` settings they ran
+    """`ADVICE` for the ending most failing greedy rollouts had, under the `learner` settings they ran
     with (move corrections already on: only the step is left to try)."""
     if worst == "obstacle" and learner["move_correction"]:
         return "a smaller learner.step (move corrections are on)"
@@ -88,14 +99,17 @@ def end_advice(worst: str, learner: dict[str, Any]) -> str | None:
 
 
 def timeout_advice(policy: Any, returns: NDArray[np.float64]) -> str:
-    """What to try when most failing episodes time out, by their mean reward per step (`returns`
-    of those episodes over `episode.max_steps`): at least `NEAR` hovers near the target, less
-    wanders away from it."""
+    """What to try when most failing greedy rollouts time out, by their mean reward per step
+    (`returns` of those rollouts over `episode.max_steps`): at least `NEAR` hovers near the
+    target, less wanders away from it. A region too narrow for the step is the check's target finding, which
+    joins the advice; near a region it does not find narrow, a smaller step did not help (the zoo's
+    snake: 28 % greedy at a quarter spacing against 40 % at half), more episodes did."""
     per_step = float(np.mean(returns)) / policy.task.to_dict()["episode"]["max_steps"]
     if per_step >= NEAR:
-        return (f"failing episodes time out near the target (mean reward {per_step:.2f} per step): a smaller "
-                "learner.step, so a move can land inside target.reach_radius")
-    return (f"failing episodes time out away from the target (mean reward {per_step:.2f} per step): where they "
+        return (f"failing greedy rollouts time out near the target (mean reward {per_step:.2f} per step): the "
+                "policy hovers beside the target region, where the learnt values differ by less than their errors; more --episodes "
+                "with --episode.stop-window 0 (the zoo's snake: 40 % greedy at the defaults, 65 % with 6000 episodes)")
+    return (f"failing greedy rollouts time out away from the target (mean reward {per_step:.2f} per step): where they "
             "wander (failures.png) the learnt value is flat; more --episodes, or starts through there")
 
 
@@ -119,8 +133,8 @@ def stop_advice(reached: NDArray[np.bool_], runs: NDArray[np.int_]) -> str | Non
 def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings: Any = None) -> Verdict:
     """The verdict of the module docs on `policy` (a LatentPolicy with its training record), from
     `episodes` rollouts per trial and policy; `findings`: a `check.CheckReport` whose advice joins."""
-    rollouts = {kind: policy.rollout(episodes, seed=seed, policy=kind)["summary"] for kind in ("greedy", "softmax",
-                                                                                               "random")}
+    runs_of = {kind: policy.rollout(episodes, seed=seed, policy=kind) for kind in ("greedy", "softmax", "random")}
+    rollouts = {kind: run["summary"] for kind, run in runs_of.items()}
     best = max(success_share(rollouts["greedy"]), success_share(rollouts["softmax"]))
     control = success_share(rollouts["random"])
     reached = np.asarray(policy.record["reached"], dtype=bool)
@@ -146,15 +160,17 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
     late_ends = end_counts(late)
     steps: list[str] = []
     if verdict != "learnt":
-        failing = late[~last(reached, fifth)]
+        greedy = runs_of["greedy"]
+        missed = ~succeeded(greedy, rollouts["greedy"])
+        failing = np.asarray(greedy["ends"]).ravel()[missed]
         if failing.size:
             worst = names[int(np.bincount(failing, minlength=len(names)).argmax())]
             advice = end_advice(worst, policy.task.to_dict()["learner"])
             if advice is not None:
-                steps.append(f"most failing episodes end as {worst}: {advice}")
+                steps.append(f"most failing greedy rollouts end as {worst}: {advice}")
             elif worst == "timeout":
-                steps.append(timeout_advice(policy, last(np.asarray(policy.record["returns"]), fifth)[
-                    ~last(reached, fifth)][failing == names.index("timeout")]))
+                returns = np.asarray(greedy["returns"]).ravel()[missed]
+                steps.append(timeout_advice(policy, returns[failing == names.index("timeout")]))
         if rising:
             steps.append("the reach rate was still rising at the end: more --episodes")
         stopped = stop_advice(reached, runs)
