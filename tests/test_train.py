@@ -307,6 +307,7 @@ def test_the_advice_follows_how_the_greedy_rollouts_failed_not_training() -> Non
     explores) while its greedy rollouts mostly hovered beside the target; the advice was for the
     wall. It follows the greedy rollouts that missed, the policy `act()` runs."""
     from types import SimpleNamespace
+    from typing import Any
 
     from latentrl.episode_ends import end_reasons
     from latentrl.rollout_summary import rollout_summary
@@ -319,7 +320,7 @@ def test_the_advice_follows_how_the_greedy_rollouts_failed_not_training() -> Non
     greedy = {"ends": np.array([[timeout] * 6 + [obstacle] * 2]), "reached": np.array([[True] * 3 + [False] * 5]),
               "returns": np.full((1, 8), 70.0)}
 
-    def rollout(episodes: int, seed: int, policy: str) -> dict[str, object]:
+    def rollout(episodes: int, seed: int, policy: str) -> dict[str, Any]:
         run = greedy if policy == "greedy" else {**greedy, "reached": np.zeros((1, 8), dtype=bool)}
         return {**run, "summary": rollout_summary(run["ends"].ravel(), run["reached"].ravel(),
                                                   run["returns"].ravel(), task)}
@@ -327,11 +328,11 @@ def test_the_advice_follows_how_the_greedy_rollouts_failed_not_training() -> Non
     training = np.array([[timeout] * 10 + [obstacle] * 40])
     policy = SimpleNamespace(task=task, rollout=rollout, record={
         "ends": training, "reached": np.arange(50)[None] < 5, "returns": np.zeros(training.shape)})
-    verdict = training_verdict(policy, episodes=8)  # type: ignore[arg-type]
+    verdict = training_verdict(policy, episodes=8)
     assert verdict.late_ends["obstacle"] == 10 and verdict.late_ends["timeout"] == 0
     assert len(verdict.next) == 1 and "time out near the target (mean reward 0.70 per step)" in verdict.next[0]
     greedy["ends"] = np.array([[timeout] * 3 + [obstacle] * 5])
-    assert "most failing greedy rollouts end as obstacle" in training_verdict(policy, episodes=8).next[0]  # type: ignore[arg-type]
+    assert "most failing greedy rollouts end as obstacle" in training_verdict(policy, episodes=8).next[0]
 
 
 def test_a_trial_stopped_in_a_dip_below_another_is_told() -> None:

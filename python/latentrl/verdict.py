@@ -91,8 +91,8 @@ def succeeded(run: dict[str, Any], summary: dict[str, Any]) -> NDArray[np.bool_]
 
 
 def end_advice(worst: str, learner: dict[str, Any]) -> str | None:
-    """`ADVICE` for the ending most failing greedy rollouts had, under the `learner` settings they ran
-    with (move corrections already on: only the step is left to try)."""
+    """`ADVICE` for the ending most failing greedy rollouts had, under the `learner` settings
+    they ran with (move corrections already on: only the step is left to try)."""
     if worst == "obstacle" and learner["move_correction"]:
         return "a smaller learner.step (move corrections are on)"
     return ADVICE.get(worst)
@@ -101,16 +101,17 @@ def end_advice(worst: str, learner: dict[str, Any]) -> str | None:
 def timeout_advice(policy: Any, returns: NDArray[np.float64]) -> str:
     """What to try when most failing greedy rollouts time out, by their mean reward per step
     (`returns` of those rollouts over `episode.max_steps`): at least `NEAR` hovers near the
-    target, less wanders away from it. A region too narrow for the step is the check's target finding, which
-    joins the advice; near a region it does not find narrow, a smaller step did not help (the zoo's
-    snake: 28 % greedy at a quarter spacing against 40 % at half), more episodes did."""
+    target, less wanders away from it. A region too narrow for the step is the check's target
+    finding, which joins the advice; beside a region it finds wide enough, a smaller step did not
+    help (the zoo's snake: 28 % greedy at a quarter spacing, 40 % at half), more episodes did."""
     per_step = float(np.mean(returns)) / policy.task.to_dict()["episode"]["max_steps"]
     if per_step >= NEAR:
-        return (f"failing greedy rollouts time out near the target (mean reward {per_step:.2f} per step): the "
-                "policy hovers beside the target region, where the learnt values differ by less than their errors; more --episodes "
-                "with --episode.stop-window 0 (the zoo's snake: 40 % greedy at the defaults, 65 % with 6000 episodes)")
-    return (f"failing greedy rollouts time out away from the target (mean reward {per_step:.2f} per step): where they "
-            "wander (failures.png) the learnt value is flat; more --episodes, or starts through there")
+        return (f"failing greedy rollouts time out near the target (mean reward {per_step:.2f} per step): "
+                "the policy hovers beside the target region, where the learnt values differ by less than "
+                "their errors; more --episodes with --episode.stop-window 0 (the zoo's snake: 40 % greedy "
+                "at the defaults, 65 % with 6000 episodes)")
+    return (f"failing greedy rollouts time out away from the target (mean reward {per_step:.2f} per step): "
+            "where they wander (failures.png) the learnt value is flat; more --episodes, or starts through there")
 
 
 def stop_advice(reached: NDArray[np.bool_], runs: NDArray[np.int_]) -> str | None:
