@@ -129,9 +129,9 @@ def _read_csv(path: Path) -> Demonstrations:
 
 
 def _numbers_below_header(text: str) -> Demonstrations | None:
-    """A header of names over rows of plain numbers, parsed by NumPy's C reader (2 million rows
-    of 7 joints in 3.5 s, not 19); None for anything else, which `_read_csv` reads cell by cell
-    (and names the line, the posture and the joint of what is wrong)."""
+    """A header of names over rows of plain finite numbers, parsed by NumPy's C reader (2 million
+    rows of 7 joints in 3.5 s, not 19); None for anything else, which `_read_csv` reads cell by
+    cell (and names the line, the posture and the joint of what is wrong)."""
     header, _, body = text.partition("\n")
     names = next(csv.reader([header]), [])
     if not names or not body.strip():
@@ -140,8 +140,8 @@ def _numbers_below_header(text: str) -> Demonstrations | None:
         values = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2, dtype=np.float64)
     except ValueError:
         return None
-    if values.shape[1] != len(names):
-        return None
+    if values.shape[1] != len(names) or not np.isfinite(values).all():
+        return None  # a non-finite value: the cell-by-cell reader names its line
     return Demonstrations(values, tuple(name.strip() for name in names))
 
 
