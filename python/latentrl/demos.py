@@ -134,7 +134,7 @@ def _numbers_below_header(text: str) -> Demonstrations | None:
     cell (and names the line, the posture and the joint of what is wrong)."""
     header, _, body = text.partition("\n")
     names = next(csv.reader([header]), [])
-    if not names or not body.strip():
+    if not names or not body or body.isspace():  # isspace, not strip: no copy of a large body
         return None
     try:
         values = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2, dtype=np.float64)
