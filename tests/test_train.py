@@ -357,6 +357,7 @@ def test_obstacle_advice_does_not_repeat_what_the_run_already_did() -> None:
 
     assert "move_correction = true" in str(end_advice("obstacle", {"move_correction": False}))
     assert "move_correction" not in str(end_advice("obstacle", {"move_correction": True}))
+    assert all("servo.kd" in str(end_advice("obstacle", {"move_correction": on})) for on in (False, True))
     assert end_advice("timeout", {"move_correction": False}) is None
 
 

@@ -40,7 +40,9 @@ NEAR = 0.5
 target: the reward exp(−θ ‖(h − h*)/ℓ‖²) is ½ at ‖h − h*‖ = ℓ √(ln 2 / θ), 1.4 ℓ at θ = 0.35."""
 
 ADVICE = {
-    "obstacle": "learner.move_correction = true (moves that meet an obstacle on the way), or a smaller learner.step",
+    "obstacle": "learner.move_correction = true (moves that meet an obstacle on the way), or more servo damping "
+                "(servo.kd): the arm swings into it between postures that keep clear (the zoo's snake, 8 trials: "
+                "kd 2 → 8 took greedy reach from 42 to 70 %, move corrections to 28 %)",
     "drop": "a smaller learner.step or stiffer servos (the check's servos finding): the constraint breaks on the way",
     "fall": "a smaller learner.step, or demos that keep the robot balanced (fall.min_start_margin)",
     "box_exit": "a larger --latent-margin: the learner presses against the latent box's edge",
@@ -92,9 +94,9 @@ def succeeded(run: dict[str, Any], summary: dict[str, Any]) -> NDArray[np.bool_]
 
 def end_advice(worst: str, learner: dict[str, Any]) -> str | None:
     """`ADVICE` for the ending most failing greedy rollouts had, under the `learner` settings
-    they ran with (move corrections already on: only the step is left to try)."""
+    they ran with (move corrections already on: servo damping and the step are left to try)."""
     if worst == "obstacle" and learner["move_correction"]:
-        return "a smaller learner.step (move corrections are on)"
+        return "more servo damping (servo.kd), or a smaller learner.step (move corrections are on)"
     return ADVICE.get(worst)
 
 
