@@ -300,11 +300,10 @@ where
             got: format!("{} rows", templates.len()),
         });
     }
-    let probe = make_plant(options.first_trial)?;
+    let mut probe = make_plant(options.first_trial)?;
     for template in templates {
         template.check_space(space, probe.posture_dim())?;
     }
-    drop(probe);
     let template = |trial: usize| {
         &templates[if templates.len() == 1 {
             0
@@ -312,6 +311,19 @@ where
             trial - options.first_trial
         }]
     };
+    if options.phase == Phase::Train && options.test_episodes > 0 {
+        // A test-start rule no start meets fails here, not after the training it would lose.
+        let mut tester = template(options.first_trial).clone();
+        tester.set_phase(Phase::Test);
+        let mut scratch = tester.scratch(space, probe.posture_dim());
+        tester.start(
+            &mut probe,
+            space,
+            &mut trial_rng(options.base_seed, options.first_trial),
+            &mut scratch,
+        )?;
+    }
+    drop(probe);
     let trials = options.first_trial..options.first_trial + options.n_trials;
     trials
         .into_par_iter()
@@ -597,7 +609,7 @@ mod tests {
 
     #[test]
     fn a_seeded_start_follows_its_seed() {
-        let mut line = Line { x: 0.0 };
+        let mut line = line();
         let start = seeded_start(&mut line, 3);
         assert_eq!((start.len(), start.clone()), (1, seeded_start(&mut line, 3)));
         assert_ne!(start, seeded_start(&mut line, 4));
@@ -622,9 +634,17 @@ mod tests {
         assert_ne!(trial_rng(1, 0).next_u64(), trial_rng(2, 0).next_u64());
     }
 
-    /// A 1-D line: starts uniform in [0, 1], a test start below 0.5; the reward is x.
+    /// A 1-D line: starts uniform in [0, 1], a test start below `test_below` (0.5); the reward is x.
     struct Line {
         x: f64,
+        test_below: f64,
+    }
+
+    fn line() -> Line {
+        Line {
+            x: 0.0,
+            test_below: 0.5,
+        }
     }
 
     impl Plant for Line {
@@ -653,8 +673,39 @@ mod tests {
             out[0] = self.x;
         }
         fn admits_test_start(&self) -> bool {
-            self.x < 0.5
+            self.x < self.test_below
         }
+    }
+
+    /// A test-start rule that no start meets failed after the whole training, which it lost.
+    #[test]
+    fn a_test_start_rule_no_start_meets_fails_before_training() {
+        let config = crate::LearnerConfig {
+            rbf_per_dim: 11,
+            ..Default::default()
+        };
+        let rules = crate::EpisodeRules {
+            max_steps: 5,
+            max_start_draws: 50,
+            ..Default::default()
+        };
+        let template = Learner::new(&config, rules, &[0.0], &[1.0]).unwrap();
+        let options = TrialOptions {
+            episodes: 100,
+            test_episodes: 3,
+            ..Default::default()
+        };
+        let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
+        let plant = |_| {
+            Ok(Line {
+                x: 0.0,
+                test_below: -1.0,
+            })
+        };
+        let one = std::slice::from_ref(&template);
+        let err = run_trials(one, &StateSpace::Full, plant, &options, &cancel, &done).unwrap_err();
+        assert!(matches!(err, CoreError::NoValidStart { draws: 50 }), "{err}");
+        assert_eq!(done.load(Ordering::Relaxed), 0, "no training episode ran");
     }
 
     #[test]
@@ -682,7 +733,7 @@ mod tests {
                 ..Default::default()
             };
             let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
-            let plant = |_| Ok(Line { x: 0.0 });
+            let plant = |_| Ok(line());
             let one = std::slice::from_ref(&template);
             let trial = run_trials(one, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
             assert_eq!(template.weights(), &(0..11).map(f64::from).collect::<Vec<_>>()[..]);
@@ -732,7 +783,7 @@ mod tests {
                 ..Default::default()
             };
             let (cancel, done) = (AtomicBool::new(false), AtomicUsize::new(0));
-            let plant = |_| Ok(Line { x: 0.0 });
+            let plant = |_| Ok(line());
             let one = std::slice::from_ref(&template);
             let trial = run_trials(one, &StateSpace::Full, plant, &options, &cancel, &done).unwrap();
             assert_eq!(done.load(Ordering::Relaxed), 2003);
@@ -812,7 +863,7 @@ mod tests {
             let calls = AtomicUsize::new(0);
             let plant = |_| {
                 Ok(Interrupting {
-                    line: Line { x: 0.0 },
+                    line: line(),
                     calls: &calls,
                     refuse,
                     cancel: &cancel,
