@@ -117,6 +117,26 @@ def test_degrees_will_not_learn(glass):
     assert found.verdict == "will not learn" and "look like degrees" in found.message
 
 
+def test_a_dataframe_is_matched_to_the_joints_by_name(glass):
+    """Columns named as the joints, in any order, are the same postures; a misnamed column, a
+    NaN (by row and joint) and an unfitted model are refused by name before any fit."""
+    pd = pytest.importorskip("pandas")
+    task, demos, model = glass
+    frame = pd.DataFrame(demos, columns=list(task.joint_names))
+    def said(report):  # every finding but the timed cost
+        return [(f.name, f.verdict, f.message) for f in report.findings if f.name != "cost"]
+
+    assert said(check(task, frame[["wrist", "shoulder", "elbow"]], model)) == said(check(task, demos, model))
+    with pytest.raises(ValueError, match=r"missing \['elbow'\], not joints of the robot \['elbo'\]"):
+        check(task, frame.rename(columns={"elbow": "elbo"}), model)
+    holed = demos.copy()
+    holed[5, 1] = np.nan
+    with pytest.raises(ValueError, match="posture 5 .* elbow = nan"):
+        check(task, holed, model)
+    with pytest.raises(TypeError, match="fitted latentrl.GPLVM"):
+        check(task, demos, GPLVM())
+
+
 def latentrl(*args):
     return subprocess.run([sys.executable, "-m", "latentrl", *args], capture_output=True, text=True, timeout=300)
 
@@ -299,3 +319,18 @@ def test_train_refuses_a_given_step_too_small_to_survey_before_it_trains(tmp_pat
     assert proc.returncode == 1, proc.stdout + proc.stderr
     assert "learner.step = 1e-6: the latent box is" in proc.stderr and "Traceback" not in proc.stderr
     assert not (out / "returns.npz").exists() and not (out / "policy.npz").exists()
+
+
+def test_every_task_key_the_advice_names_exists():
+    """The servo advice named `servo.max_torque`, which no task file or flag takes (a flag's
+    hyphens are the key's underscores)."""
+    import re
+
+    from latentrl.task_schema import schema
+
+    keys = {e["key"] for e in schema()}
+    tables = "servo|physics|target|episode|learner|run|fall|waypoint|floor"
+    for module in ("check.py", "verdict.py", "derive.py"):
+        text = (ROOT / "python" / "latentrl" / module).read_text()
+        named = {k.replace("-", "_") for k in re.findall(rf"\b((?:{tables})\.[a-z_-]*[a-z])", text)}
+        assert named and named <= keys, (module, sorted(named - keys))

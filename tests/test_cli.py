@@ -315,7 +315,7 @@ def test_fit_inducing_fits_the_sparse_gplvm(tmp_path, flags, outcome):
 
 def test_fit_reports_bad_demonstration_files(tmp_path):
     result = latentrl("fit", str(tmp_path / "missing.csv"), "--out", str(tmp_path / "m.npz"))
-    assert result.returncode == 1 and "missing.csv" in result.stderr
+    assert result.returncode == 1 and f"demos {tmp_path / 'missing.csv'}: no such file" in result.stderr
     (tmp_path / "two.csv").write_text("a,b,c\n0,1,2\n1,2,3\n")
     result = latentrl("fit", str(tmp_path / "two.csv"), "--out", str(tmp_path / "m.npz"))
     assert result.returncode == 1 and "2 postures, expected at least 3" in result.stderr
@@ -368,3 +368,16 @@ def test_resume_names_what_is_wrong_with_returns_npz(tmp_path):
         result = latentrl("run", "exp1", "--no-progress", "--resume", str(out))
         assert result.returncode == 1 and "Traceback" not in result.stderr, (name, result.stderr)
         assert f"{out / 'returns.npz'}: " in result.stderr and message in result.stderr, (name, result.stderr)
+
+
+def test_a_missing_input_or_an_empty_path_is_named_before_any_work(tmp_path):
+    """`--model nothere.npz` failed after reading the demos with a bare errno; `--out ''` (an
+    unset variable) wrote the run into the current directory."""
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    task, demos = str(example / "glass_arm.toml"), str(example / "demos.csv")
+    result = latentrl("train", task, "--demos", demos, "--model", "nothere.npz", "--out", str(tmp_path / "run"))
+    assert result.returncode == 1 and "--model nothere.npz: no such file or directory" in result.stderr, result.stderr
+    result = latentrl("check", task, "--demos", "nothere.csv")
+    assert result.returncode == 1 and "--demos nothere.csv: no such file or directory" in result.stderr, result.stderr
+    result = latentrl("train", task, "--demos", demos, "--out", "")
+    assert result.returncode == 2 and "argument --out: an empty path" in result.stderr, result.stderr

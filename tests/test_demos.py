@@ -100,6 +100,9 @@ def write(tmp_path, name, text):
         ("d.csv", "a,b\n", "at least one posture"),
         ("d.csv", "a,b\n1,2\n3\n", r"line 3 \(posture 1\): 1 values, expected 2"),
         ("d.csv", "a,b\n1,2\n3,x\n", r"line 3 \(posture 1\), joint 'b': 'x' is not a number"),
+        ("d.csv", "a,b\n1,2\n3,0_5\n", r"line 3 \(posture 1\), joint 'b': '0_5' is not a number"),  # float() reads 5
+        ("d.csv", "a;b\n1;2\n", "line 1 is one column, 'a;b': the file is separated by ';', not by commas"),
+        ("d.csv", "a\tb\n1\t2\n", "separated by '\\\\t', not by commas"),
         ("d.csv", "a,b\n1,2\n3,nan\n", "posture 1, joint 'b': non-finite value nan"),
         ("d.csv", "a,b\ninf,2\n", "posture 0, joint 'a': non-finite value inf"),
         ("d.csv", "a,b,a\n1,2,3\n", r"duplicate joint names \['a'\]"),

@@ -42,3 +42,16 @@ def test_no_tracked_file_cites_a_document_outside_the_repository():
         found += [f"{name}:{n}: {line.strip()}" for n, line in enumerate(text.splitlines(), 1)
                   if OUTSIDE.search(line)]
     assert not found, "cites a document that is not in the repository:\n" + "\n".join(found)
+
+
+def test_the_readmes_sweep_is_a_sweep():
+    """The README's sweep used a bare `[grid]` of task keys, which `latentrl sweep` refuses."""
+    import tomllib
+
+    from latentrl.experiments.sweep import Sweep
+
+    text = (DOCS.parent / "README.md").read_text()
+    block = re.search(r"## Sweeps and Ray.*?```toml\n(.*?)```", text, re.S)
+    assert block is not None, "the README lost its sweep example"
+    sweep = Sweep.from_mapping(tomllib.loads(block.group(1)), "README.md")
+    assert len(sweep.expand()) == 4

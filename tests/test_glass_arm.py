@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from latentrl import LatentPolicy, cli
+from latentrl import LatentPolicy, cli, load_demos
 
 from learning import CONTROL_ALPHA, assert_separated
 
@@ -314,3 +314,24 @@ def test_a_rollout_cut_between_its_two_files_leaves_no_stale_summary(monkeypatch
     monkeypatch.setattr(latentrl.results, "write_json", killed)
     assert cli.main([*rollout, "--seed", "7"]) == 130
     assert not (tmp_path / "ro" / "rollout.json").exists()
+
+
+def test_a_given_model_encodes_with_the_runs_encoder(tmp_path):
+    """`train --model M --encoder tracking` recorded "tracking" and ran M's own "gp" encoder; a
+    back-constrained encoder, which is another fit, is refused naming the flag and the file, and a
+    back-constrained fit runs projection and tracking but is not a "gp" one."""
+    from latentrl import GPLVM
+    from latentrl.experiments.training import TrainRun, fitted
+
+    demos = load_demos(EXAMPLE / "demos.csv").postures
+    GPLVM(n_components=2, random_state=0, max_iter=50).fit(demos).save(tmp_path / "m.npz")
+    given = dict(task_file=str(EXAMPLE / "glass_arm.toml"), demos=str(EXAMPLE / "demos.csv"), model=str(tmp_path / "m.npz"))
+    for encoder in ("tracking", "projection", "gp"):
+        assert fitted(TrainRun(**given, encoder=encoder))[2].encoder == encoder
+    with pytest.raises(ValueError, match=r"--encoder back_constrained: .*m\.npz was fitted with the 'gp' encoder"):
+        fitted(TrainRun(**given, encoder="back_constrained"))
+    GPLVM(n_components=2, random_state=0, max_iter=50, encoder="back_constrained").fit(demos).save(tmp_path / "b.npz")
+    given["model"] = str(tmp_path / "b.npz")
+    assert fitted(TrainRun(**given, encoder="tracking"))[2].encoder == "tracking"
+    with pytest.raises(ValueError, match=r"--encoder gp: .*b\.npz was fitted with the 'back_constrained' encoder"):
+        fitted(TrainRun(**given, encoder="gp"))

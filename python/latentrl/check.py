@@ -113,18 +113,18 @@ class CheckReport:
 
 
 def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | None = None) -> CheckReport:
-    """Will `task` learn from `demos` (N, D postures in its joint order)? The findings of the
-    module docs, with the settings `train` would derive where the task is silent; `model`: a
-    fitted GPLVM (default: one fitted here, d = 2, as `train` fits); `latent_margin`: the
-    box's margin (default: the task's `[run]`, else `TrainPreset`'s)."""
+    """Will `task` learn from `demos` (N, D postures in its joint order, or a DataFrame whose
+    columns name its joints)? The findings of the module docs, with the settings `train` would
+    derive where the task is silent; `model`: a fitted GPLVM (default: one fitted here, d = 2,
+    as `train` fits); `latent_margin`: the box's margin (default: the task's `[run]`, else
+    `TrainPreset`'s)."""
     from latentrl.derive import SPACING, applied, derive, even_twin
     from latentrl.gplvm import GPLVM
     from latentrl.run_settings import TrainPreset, latent_box, with_task_run
 
-    postures = np.ascontiguousarray(demos, dtype=np.float64)
-    if postures.ndim != 2 or postures.shape[1] != len(task.joint_names) or not np.isfinite(postures).all():
-        raise ValueError(f"demos: expected finite postures of shape (N, {len(task.joint_names)}) for {task.name}, "
-                         f"got {postures.shape}")
+    postures = task.postures_of(demos)
+    if model is not None and (not isinstance(model, GPLVM) or not hasattr(model, "decoder_")):
+        raise TypeError(f"model must be a fitted latentrl.GPLVM, got {model!r}")
     preset = with_task_run(TrainPreset(), task)
     even: Callable[[], Any] | None = None
     if model is None:  # fitted as `latentrl train` fits, its latent spacing derived as there
@@ -312,7 +312,7 @@ def servo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
                        f"(tolerance {tolerance * 1000:g} mm)", None, values)
     return Finding("servos", "warning", f"after {HOLD_S} s the effectors are {error * 1000:.1f} mm from the demo "
                    f"postures (tolerance {tolerance * 1000:g} mm): the servos do not hold the robot there",
-                   "stiffer servos (servo.kp, with servo.kd about 2·sqrt(kp·inertia)) or higher servo.max_torque",
+                   "stiffer servos (servo.kp, with servo.kd about 2·sqrt(kp·inertia)) or a higher servo.max_force",
                    values)
 
 

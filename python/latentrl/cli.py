@@ -30,6 +30,20 @@ def _check_writable(out: Path, *, file: bool) -> None:
         raise ValueError(f"--out {out}: cannot write under {parent}")
 
 
+INPUTS = {"task": "task file", "demos": "--demos", "model": "--model", "results": "results", "file": "sweep file",
+          "urdf": "URDF", "resume": "--resume"}
+"""The path arguments a command reads, by their `args` name, with how the user wrote them."""
+
+
+def _check_inputs(args: object) -> None:
+    """Every path a command reads exists: named as the user gave it, before any work."""
+    for name, label in INPUTS.items():
+        path = getattr(args, name, None)
+        if isinstance(path, Path) and not path.exists():
+            given = "demos" if getattr(args, "command", None) == "fit" and name == "demos" else label  # fit's is positional
+            raise ValueError(f"{given} {path}: no such file or directory")
+
+
 RECORDING_LIBRARIES = ("pyarrow", "h5py", "rosbags")
 """The libraries of the recording extras ([lerobot], [hdf5], [rosbag])."""
 
@@ -38,6 +52,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
     args = build_parser().parse_args(argv)
     try:
+        _check_inputs(args)
         out = getattr(args, "out", None)
         if out is not None:
             _check_writable(out, file=args.command in ("fit", "replay"))

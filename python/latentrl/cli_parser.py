@@ -109,6 +109,13 @@ def _add_task_flags(
                            choices=choices, default=None, metavar=entry["kind"].upper().split()[0], help=help_text)
 
 
+def _path(text: str) -> Path:
+    """A path argument; an empty one (an unset shell variable) is refused, not taken as "."."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path (an unset variable?)")
+    return Path(text)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand and flag; a subcommand's flags are added when it
     is used (`LazyParser`), so `latentrl --help` imports no experiment or its preset."""
@@ -151,11 +158,11 @@ def _experiment_flags(name: str, cmd: argparse.ArgumentParser) -> None:
     from latentrl.experiments import experiments, task_schema
 
     exp = experiments()[name]
-    cmd.add_argument("--out", type=Path, help=f"results directory (default: results/{name})")
+    cmd.add_argument("--out", type=_path, help=f"results directory (default: results/{name})")
     cmd.add_argument("--quick", action="store_true", help="the small smoke-test preset")
     if exp.rl:
         cmd.add_argument(
-            "--resume", type=Path, metavar="DIR",
+            "--resume", type=_path, metavar="DIR",
             help="continue the interrupted run in DIR with its own preset (no other preset flags)",
         )
     cmd.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
@@ -165,7 +172,7 @@ def _experiment_flags(name: str, cmd: argparse.ArgumentParser) -> None:
 
 
 def _train_flags(train: argparse.ArgumentParser) -> None:
-    train.add_argument("--out", type=Path, required=True, help="results directory (results.json, returns.npz, policy.npz)")
+    train.add_argument("--out", type=_path, required=True, help="results directory (results.json, returns.npz, policy.npz)")
     train.add_argument("--resume", action="store_true", help="continue the interrupted run in --out (same arguments)")
     _add_training_flags(train, "a short run (TrainPreset.quick)")
 
@@ -176,13 +183,13 @@ def _check_flags(check: argparse.ArgumentParser) -> None:
 
 
 def _report_flags(report: argparse.ArgumentParser) -> None:
-    report.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz)")
+    report.add_argument("results", type=_path, help="a directory of `latentrl train` (with policy.npz)")
     report.add_argument("--json", action="store_true", help="print it as JSON")
 
 
 def _rollout_flags(rollout: argparse.ArgumentParser) -> None:
-    rollout.add_argument("results", type=Path, help="a directory of `latentrl train` (with policy.npz), or a policy.npz")
-    rollout.add_argument("--out", type=Path, required=True, help="where to write rollout.json and rollout.npz")
+    rollout.add_argument("results", type=_path, help="a directory of `latentrl train` (with policy.npz), or a policy.npz")
+    rollout.add_argument("--out", type=_path, required=True, help="where to write rollout.json and rollout.npz")
     rollout.add_argument("--episodes", type=int, default=20, help="episodes per trial and policy (default: 20)")
     rollout.add_argument("--trial", type=int, help="only this trial's policy (default: every trial)")
     rollout.add_argument("--seed", type=int, default=0, help="base seed of the starts and draws (default: 0)")
@@ -198,7 +205,7 @@ def _rollout_flags(rollout: argparse.ArgumentParser) -> None:
 def _fit_flags(fit: argparse.ArgumentParser) -> None:
     from latentrl.recorded.options import DemoOptions
 
-    fit.add_argument("demos", type=Path, help=DEMOS_HELP)
+    fit.add_argument("demos", type=_path, help=DEMOS_HELP)
     fit.add_argument("--model", choices=("gplvm", "pca"), default="gplvm", help="the model (default: gplvm)")
     fit.add_argument("--n-components", type=_dimension, default=2,
                      help="latent dimension d, or auto (GPLVM: chosen by ARD relevance, docs/encoders.md; default: 2)")
@@ -210,24 +217,24 @@ def _fit_flags(fit: argparse.ArgumentParser) -> None:
     fit.add_argument("--spacing", choices=("fit", "even"), default="fit",
                      help="GPLVM latent points as fitted, or evenly spaced along each axis (docs/encoders.md#latent-spacing; "
                           "default: fit; `latentrl train` fits with even)")
-    fit.add_argument("--out", type=Path, required=True, help="the model file to write (.npz; load with GPLVM.load)")
+    fit.add_argument("--out", type=_path, required=True, help="the model file to write (.npz; load with GPLVM.load)")
     _add_preset_flags(fit, DemoOptions)
 
 
 def _plot_flags(plot: argparse.ArgumentParser) -> None:
-    plot.add_argument("results", type=Path, help="a results directory of `latentrl run exp1|exp2|exp3` or `latentrl train`")
-    plot.add_argument("--out", type=Path, help="where to write the figures (default: the results directory)")
+    plot.add_argument("results", type=_path, help="a results directory of `latentrl run exp1|exp2|exp3` or `latentrl train`")
+    plot.add_argument("--out", type=_path, help="where to write the figures (default: the results directory)")
 
 
 def _sweep_flags(sweep: argparse.ArgumentParser) -> None:
-    sweep.add_argument("file", type=Path, help="the sweep: a .toml file (or .yaml with PyYAML); see examples/sweep.toml")
+    sweep.add_argument("file", type=_path, help="the sweep: a .toml file (or .yaml with PyYAML); see examples/sweep.toml")
     sweep.add_argument("--backend", choices=("local", "ray"), default="local",
                        help="local: trials in this process (rayon); ray: one Ray task per trial (default: local)")
     sweep.add_argument("--address", metavar="ADDR",
                        help="with --backend ray: 'auto' (the cluster `ray start --head` runs here), HOST:6379, or "
                             "ray://HOST:10001 (Ray Client); default: a local Ray instance")
     sweep.add_argument("--batch", type=int, default=1, help="with --backend ray: trials per Ray task (default: 1)")
-    sweep.add_argument("--out", type=Path, help="sweep directory (default: results/<FILE's name>)")
+    sweep.add_argument("--out", type=_path, help="sweep directory (default: results/<FILE's name>)")
     sweep.add_argument("--resume", action="store_true", help="continue the sweep in --out; finished trials are kept")
     sweep.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
 
@@ -235,10 +242,10 @@ def _sweep_flags(sweep: argparse.ArgumentParser) -> None:
 def _replay_flags(replay: argparse.ArgumentParser) -> None:
     from latentrl.render import CAMERA, VIEWS
 
-    replay.add_argument("results", type=Path, help="a results directory of latentrl run exp1|exp2|exp3, latentrl train "
+    replay.add_argument("results", type=_path, help="a results directory of latentrl run exp1|exp2|exp3, latentrl train "
                                                      "or latentrl rollout")
-    replay.add_argument("--out", type=Path, help="the video: FILE.gif or FILE.mp4")
-    replay.add_argument("--rerun", type=Path, help="a Rerun recording FILE.rrd (view it with `rerun FILE.rrd`)")
+    replay.add_argument("--out", type=_path, help="the video: FILE.gif or FILE.mp4")
+    replay.add_argument("--rerun", type=_path, help="a Rerun recording FILE.rrd (view it with `rerun FILE.rrd`)")
     which = replay.add_mutually_exclusive_group(required=True)
     which.add_argument("--episode", type=int, help="a recorded training episode (the first, 10 %%, 50 %% and the last three)")
     which.add_argument("--test", type=int, help="a recorded frozen test episode (the first ten)")
@@ -255,7 +262,7 @@ def _replay_flags(replay: argparse.ArgumentParser) -> None:
 
 
 def _urdf_info_flags(urdf: argparse.ArgumentParser) -> None:
-    urdf.add_argument("urdf", type=Path, help="the robot's URDF file")
+    urdf.add_argument("urdf", type=_path, help="the robot's URDF file")
     urdf.add_argument("--json", action="store_true", help="print it as JSON instead of a table")
     urdf.add_argument("--balance-inertia", action="store_true",
                       help="repair inertias the physics refuses (triangle inequality, all zero), naming each link")
@@ -266,9 +273,9 @@ def _add_training_flags(cmd: argparse.ArgumentParser, quick: str) -> None:
     preset fields and every task key as flags (defaults: the task file's, else the schema's)."""
     from latentrl.experiments.training import TrainRun
 
-    cmd.add_argument("task", type=Path, help="the task file (TOML; docs/tasks.md)")
-    cmd.add_argument("--demos", type=Path, required=True, help=DEMOS_HELP)
-    cmd.add_argument("--model", type=Path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2)")
+    cmd.add_argument("task", type=_path, help="the task file (TOML; docs/tasks.md)")
+    cmd.add_argument("--demos", type=_path, required=True, help=DEMOS_HELP)
+    cmd.add_argument("--model", type=_path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2)")
     cmd.add_argument("--quick", action="store_true", help=quick)
     cmd.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     _add_preset_flags(cmd, TrainRun, exclude=("task_file", "demos", "model"))

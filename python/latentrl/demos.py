@@ -94,8 +94,8 @@ class Demonstrations:
 
 
 def _number(cell: Any, where: str) -> float:
-    if isinstance(cell, (int, float, str)) and not isinstance(cell, bool):
-        try:
+    if isinstance(cell, (int, float, str)) and not isinstance(cell, bool) and not (isinstance(cell, str) and "_" in cell):
+        try:  # no "_": Python reads "0_5" as 5
             return float(cell)
         except ValueError:
             pass
@@ -124,6 +124,9 @@ def _read_csv(path: Path) -> Demonstrations:
         raise ValueError("empty file (no header row)")
     (_, header), body = lines[0], lines[1:]
     names = [name.strip() for name in header]
+    other = next((sep for sep in (";", "\t", "|") if len(names) == 1 and sep in names[0]), None)
+    if other is not None:
+        raise ValueError(f"line 1 is one column, {names[0]!r}: the file is separated by {other!r}, not by commas")
     rows = [(f"line {line} (posture {i})", row) for i, (line, row) in enumerate(body)]
     return Demonstrations(_table(rows, names), tuple(names))
 

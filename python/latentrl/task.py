@@ -182,6 +182,26 @@ class Task:
         self._refuse_degrees(chosen, where)
         return chosen
 
+    def postures_of(self, demos: Any, where: str = "demos") -> NDArray[np.float64]:
+        """`demos` as this robot's (N, D) postures: a DataFrame whose columns are named (strings)
+        is matched to the joints by name (`demo_postures`); other arrays must hold the joints in
+        `joint_names` order. ValueError naming `where`, the shape or the joint that does not fit."""
+        from latentrl._estimator import column_names
+
+        names = column_names(demos)
+        rows = np.asarray(demos, dtype=np.float64)
+        if names is not None:
+            return self.demo_postures([str(n) for n in names], rows, where)
+        if rows.ndim != 2 or rows.shape[1] != len(self.joint_names):
+            raise ValueError(f"{where}: expected postures of shape (N, {len(self.joint_names)}) for {self.name}'s "
+                             f"joints {list(self.joint_names)}, got shape {rows.shape}")
+        bad = np.argwhere(~np.isfinite(rows))
+        if len(bad):
+            row, column = bad[0]
+            raise ValueError(f"{where}: posture {row} (counting from 0) has {self.joint_names[column]} = "
+                             f"{rows[row, column]}: expected finite numbers ({len(bad)} such values)")
+        return np.ascontiguousarray(rows)
+
     def _refuse_degrees(self, postures: NDArray[np.float64], where: str) -> None:
         """ValueError naming `where`, the first such posture and its joint when a value lies beyond
         ±2π rad and outside its joint's limits (`DEGREES`)."""

@@ -70,6 +70,11 @@ def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, mode
     if model:
         if gplvm.n_features_in_ != len(task.joint_names):
             raise ValueError(f"{model}: fitted to {gplvm.n_features_in_} joints, the task's robot has {len(task.joint_names)}")
+        fit = gplvm.fitted_encoder_  # "gp" or "back_constrained": projection and tracking run on either
+        if encoder in ("gp", "back_constrained") and encoder != fit:
+            raise ValueError(f"--encoder {encoder}: {model} was fitted with the {fit!r} encoder, which is another fit; "
+                             f"refit it (latentrl fit --encoder {encoder}) or give --encoder {fit}, projection or tracking")
+        gplvm.set_params(encoder=encoder)  # the run's encoder (flag, [run] table, default) maps the RL loop's states
     else:
         try:
             gplvm.fit(postures)
@@ -255,8 +260,8 @@ def train_latent_policy(
     `preset` is ``"quick"`` (a short budget) or ``"paper"`` (the full one); the task's `[run]`
     table replaces the paper preset's run settings, `fields` override the result by name
     (``trials=4, episodes=500, seed=1``), `overrides` the task's keys by path
-    (``overrides={"learner.alpha": 0.5, "episode.max_steps": 200}``). `demos` (N, D): the postures a ``start = "demo"``
-    task starts from (default: the model's training postures). The latent box is the bounding
+    (``overrides={"learner.alpha": 0.5, "episode.max_steps": 200}``). `demos` (N, D, or a DataFrame whose columns name
+    the joints): the postures a ``start = "demo"`` task starts from (default: the model's training postures). The latent box is the bounding
     box of ``model.Z_`` widened by ``latent_margin``. Ctrl-C stops the run with
     `KeyboardInterrupt`.
     """
@@ -274,7 +279,7 @@ def train_latent_policy(
             f"{task.name} needs a GPLVM fitted to postures of its {len(task.joint_names)} joints "
             f"{list(task.joint_names)}; got n_features_in_={model.n_features_in_}"
         )
-    starts = np.asarray(model.X_train_ if demos is None else demos, dtype=np.float64)
+    starts = model.X_train_ if demos is None else task.postures_of(demos)
     low, high = latent_box(model.Z_, chosen.latent_margin)
     if isinstance(chosen, TrainPreset):  # a Task of yours (not a shipped experiment): derive what it leaves open
         from latentrl.derive import applied, derive
