@@ -334,3 +334,17 @@ def test_every_task_key_the_advice_names_exists():
         text = (ROOT / "python" / "latentrl" / module).read_text()
         named = {k.replace("-", "_") for k in re.findall(rf"\b((?:{tables})\.[a-z_-]*[a-z])", text)}
         assert named and named <= keys, (module, sorted(named - keys))
+
+
+def test_a_home_posture_outside_the_joint_limits_is_named_by_its_row(tmp_path):
+    """The CLI said only `invalid position … for joint "wrist"`, from the survey after the fit."""
+    urdf = (EXAMPLE / "glass_arm.urdf").read_text()
+    assert 'lower="-6.0" upper="6.0"' in urdf
+    (tmp_path / "glass_arm.urdf").write_text(urdf.replace('lower="-6.0" upper="6.0"', 'lower="-1.0" upper="1.0"'))
+    (tmp_path / "task.toml").write_text((EXAMPLE / "glass_arm.toml").read_text())
+    said = 'demos row 0 (the home posture, episode.start_demo): invalid position'
+    done = latentrl("check", str(tmp_path / "task.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--no-progress")
+    assert done.returncode == 1 and f"demos.csv: {said}" in done.stderr and "wrist" in done.stderr, done.stderr
+    task = Task.load(tmp_path / "task.toml")
+    found = check(task, load_demos(EXAMPLE / "demos.csv").postures).findings[0]
+    assert found.verdict == "will not learn" and found.message.startswith(said)

@@ -171,10 +171,8 @@ def demo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
                        "write the demonstrations in radians (np.deg2rad)", {"joints": looks_like_degrees})
     try:
         codes, _, _ = task.plant(demos).classify(np.ascontiguousarray(demos))
-    except ValueError as err:  # e.g. the start demo outside the joint limits
-        row = task.to_dict()["episode"]["start_demo"]
-        return Finding("demos", "will not learn", f"row {row} (the home posture, episode.start_demo): {err}",
-                       "fix the demonstrations (or episode.start_demo)")
+    except ValueError as err:  # the home posture (Task.plant names it) outside the joint limits
+        return Finding("demos", "will not learn", str(err), "fix the demonstrations (or episode.start_demo)")
     names = end_reasons()
     broken = {names[c]: np.flatnonzero(codes == c).tolist() for c in np.unique(codes) if c != 0}
     rows = sorted(r for rs in broken.values() for r in rs)

@@ -153,9 +153,17 @@ class Task:
         return task_digest(self.to_dict(), self.urdf_path)
 
     def plant(self, demos: NDArray[np.float64] | None = None) -> _native.TaskPlant:
-        """The native plant of this task (home posture: demo `episode.start_demo` of `demos`)."""
+        """The native plant of this task (home posture: demo `episode.start_demo` of `demos`); a
+        home posture the robot cannot take is named by its row."""
         rows = None if demos is None else np.ascontiguousarray(demos, dtype=np.float64)
-        return _native.TaskPlant(self._native, rows)
+        try:
+            return _native.TaskPlant(self._native, rows)
+        except ValueError as err:
+            if rows is None:
+                raise
+            _native.TaskPlant(self._native, None)  # raises alike unless the home posture is the cause
+            row = self.to_dict()["episode"]["start_demo"]
+            raise type(err)(f"demos row {row} (the home posture, episode.start_demo): {err}") from err
 
     def check_joints(self, joint_names: tuple[str, ...] | list[str], where: str) -> None:
         """ValueError naming `where` unless `joint_names` are this robot's actuated joints in order."""

@@ -65,6 +65,10 @@ def _inputs(task_file: str, overrides: str, demos: str, options: DemoOptions) ->
 def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, model: str,
           seed: int, max_iter: int, encoder: str, spacing: str) -> tuple[Task, np.ndarray, GPLVM]:
     task, postures = _inputs(task_file, overrides, demos, options)
+    try:
+        task.plant(postures)  # the home posture (a demo) the robot must take, before any fit
+    except ValueError as err:
+        raise ValueError(f"{demos}: {err}") from err
     gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder,
                                                   spacing=spacing)
     if model:
