@@ -110,7 +110,7 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
         budget = config["episode"]["max_steps"] if "episode.max_steps" in given else _default("episode.max_steps")
 
         def step_on(m: Any) -> tuple[float, dict[str, Any], str, bool] | None:
-            return learner_step(lambda s: survey_at_step(task.replace({"learner.step": s}), m, low, high, demos), budget)
+            return learner_step(lambda s: survey_at_step(task.replace({"learner.step": s}, task.origin), m, low, high, demos), budget)
 
         spaced = even is not None and getattr(model, "spacing", "fit") == "even"  # a run's model, read back
         found = None if spaced else step_on(model)
@@ -122,7 +122,7 @@ def derive(task: Task, model: Any, low: NDArray[np.float64], high: NDArray[np.fl
             step, survey, rule, _ = found
             out.append(Derived("learner.step", step, rule))
     if "episode.max_steps" not in given:
-        survey = survey or survey_at_step(task.replace({"learner.step": step}), model, low, high, demos)
+        survey = survey or survey_at_step(task.replace({"learner.step": step}, task.origin), model, low, high, demos)
         needed = moves95(survey)
         if needed is not None:
             default = _default("episode.max_steps")
@@ -195,7 +195,7 @@ def servo_gains(task: Task, demos: NDArray[np.float64]) -> list[Derived]:
     tolerance, tried = servo_tolerance(task), []
     for scale, damping in itertools.product(SERVO_SCALES, SERVO_DAMPING):
         gains = {"servo.kp": kp0 * scale, "servo.kd": kd0 * scale * damping}
-        error = servo_error(task.replace(gains), demos)
+        error = servo_error(task.replace(gains, task.origin), demos)
         if error is None:
             return []
         tried.append((error, scale, damping, gains))

@@ -159,10 +159,13 @@ class Task:
         try:
             return _native.TaskPlant(self._native, rows)
         except ValueError as err:
-            if rows is None:
-                raise
-            _native.TaskPlant(self._native, None)  # raises alike unless the home posture is the cause
             row = self.to_dict()["episode"]["start_demo"]
+            if rows is None or rows.ndim != 2 or rows.shape[1] != len(self.joint_names) or not 0 <= row < len(rows):
+                raise  # no such row or posture: the native message says so
+            try:
+                _native.TaskPlant(self._native, None)
+            except ValueError:
+                raise err from None  # not the home posture's fault
             raise type(err)(f"demos row {row} (the home posture, episode.start_demo): {err}") from err
 
     def check_joints(self, joint_names: tuple[str, ...] | list[str], where: str) -> None:

@@ -167,9 +167,52 @@ pub fn check_positive(name: &'static str, value: f64) -> Result<()> {
     }
 }
 
+/// A deserializer's message with Rust's type names as a task file's author would say them
+/// (`expected usize` → `expected a whole number ≥ 0`): the one wording of every key's type error.
+pub fn plain_types(message: &str) -> String {
+    const WORDS: [(&str, &str); 5] = [
+        ("usize", "a whole number ≥ 0"),
+        ("u64", "a whole number ≥ 0"),
+        ("u32", "a whole number ≥ 0"),
+        ("i64", "a whole number"),
+        ("f64", "a number"),
+    ];
+    WORDS.iter().fold(message.to_string(), |text, (rust, plain)| {
+        let (from, to) = (format!("expected {rust}"), format!("expected {plain}"));
+        // Whole words only: "expected u64" must not touch "expected u64s".
+        let mut out = String::with_capacity(text.len());
+        let mut rest = text.as_str();
+        while let Some(i) = rest.find(&from) {
+            let end = i + from.len();
+            let whole = !rest[end..].starts_with(|c: char| c.is_alphanumeric() || c == '_');
+            out.push_str(&rest[..i]);
+            out.push_str(if whole { &to } else { &from });
+            rest = &rest[end..];
+        }
+        out.push_str(rest);
+        out
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn type_errors_say_what_a_user_writes() {
+        assert_eq!(
+            plain_types("invalid value: integer `-1`, expected usize"),
+            "invalid value: integer `-1`, expected a whole number ≥ 0"
+        );
+        assert_eq!(
+            plain_types("invalid type: string \"x\", expected f64"),
+            "invalid type: string \"x\", expected a number"
+        );
+        assert_eq!(
+            plain_types("expected u64s or expected i64"),
+            "expected u64s or expected a whole number"
+        );
+    }
 
     #[test]
     fn kinds_sort_input_from_numerics_and_cancel() {

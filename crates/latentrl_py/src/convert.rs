@@ -76,7 +76,7 @@ const MAX_CONFIG_DEPTH: usize = 32;
 
 /// A configuration (`TaskConfig`, `LearnerConfig`, …) from a Python dict: read as the TOML
 /// value it stands for, then deserialised as a task file is, so a bad value gets the task
-/// file's message (`learner.gamma: invalid type: string "x", expected f64`), naming `what` and
+/// file's message (`learner.gamma: invalid type: string "x", expected a number`), naming `what` and
 /// the key path. A None value is a key left out (TOML has no null).
 pub fn config_from<T: DeserializeOwned>(what: &str, value: &Bound<'_, PyAny>) -> PyResult<T> {
     let fail = |path: &str, message: String| {
@@ -93,7 +93,7 @@ pub fn config_from<T: DeserializeOwned>(what: &str, value: &Bound<'_, PyAny>) ->
     let value = toml_value(value, "", 0).map_err(|(path, message)| fail(&path, message))?;
     serde_path_to_error::deserialize(value).map_err(|e| {
         let path = e.path().to_string();
-        fail(&path, e.into_inner().message().to_string())
+        fail(&path, latent_core::error::plain_types(e.into_inner().message()))
     })
 }
 

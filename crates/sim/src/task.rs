@@ -199,7 +199,7 @@ impl Task {
 }
 
 /// A [`TaskConfig`] from TOML text; an error names the key path and the line
-/// (`learner.gamma (line 54): invalid type: string "x", expected f64`).
+/// (`learner.gamma (line 54): invalid type: string "x", expected a number`).
 pub fn parse_toml(text: &str) -> std::result::Result<TaskConfig, String> {
     let at = |span: Option<std::ops::Range<usize>>| {
         span.map_or(String::new(), |s| {
@@ -215,6 +215,10 @@ pub fn parse_toml(text: &str) -> std::result::Result<TaskConfig, String> {
         } else {
             path
         };
-        format!("{key}{}: {}", at(inner.span()), inner.message())
+        format!(
+            "{key}{}: {}",
+            at(inner.span()),
+            latent_core::error::plain_types(inner.message())
+        )
     })
 }
