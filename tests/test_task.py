@@ -62,6 +62,8 @@ def test_shipped_tasks_load_with_their_robots():
         (('urdf = "../data/two_arms.urdf"', 'urdf = "../data/no_such.urdf"'), r"urdf: cannot read URDF file .*no_such.urdf"),
         (("[learner]", "[run]\ntrials = 0\n\n[learner]"), r"task.toml: run.trials must be an integer in \[1, 1000000\], got 0"),
         (("[learner]", '[run]\nencoder = "pca"\n\n[learner]'), r"task.toml: run.encoder \(line \d+\): unknown variant `pca`"),
+        (('links = ["left_hand", "right_hand"]', 'links = ["left_hand", "left_hand"]'),
+         r'constraints\[0\].links must name two different links, got "left_hand" twice'),
     ],
 )
 def test_bad_task_files_name_the_file_the_key_and_the_rule(tmp_path, edit, message):
@@ -183,3 +185,19 @@ def test_a_task_file_with_a_byte_order_mark_loads(tmp_path):
     task = Task.load(path)
     assert task.given == Task.load(example / "glass_arm.toml").given
     assert task.to_dict() == Task.load(example / "glass_arm.toml").to_dict()
+
+
+def test_a_robot_that_cannot_move_or_a_sole_without_a_box_is_refused_at_load(tmp_path):
+    """Both loaded: the first then failed `check` on its demo columns ("missing []"), the second
+    on its first reset ("invalid parameter sole = NaN")."""
+    glass = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    (tmp_path / "glass_arm.urdf").write_text((glass / "glass_arm.urdf").read_text().replace('type="revolute"', 'type="fixed"'))
+    (tmp_path / "task.toml").write_text((glass / "glass_arm.toml").read_text())
+    with pytest.raises(ValueError, match=r'urdf: the robot "glass_arm" has no actuated joint'):
+        Task.load(tmp_path / "task.toml")
+    lift = shipped_path("humanoid_lift")
+    text = lift.read_text()
+    soles = next(line for line in text.splitlines() if line.startswith("soles"))
+    path = write(tmp_path, text.replace(soles, 'soles = ["l_hand"]'), "lift.toml")
+    with pytest.raises(ValueError, match=r'fall.soles\[0\]: link "l_hand" has no box collision shape'):
+        Task.load(path)

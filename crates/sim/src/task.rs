@@ -125,7 +125,24 @@ impl Task {
         if let Some(fall) = &config.fall {
             for (i, s) in fall.soles.iter().enumerate() {
                 link(format!("fall.soles[{i}]"), s)?;
+                let boxed = model.robot.links.iter().filter(|l| &l.name == s).any(|l| {
+                    l.collision
+                        .iter()
+                        .any(|c| matches!(c.geometry, rapier3d_urdf::urdf_rs::Geometry::Box { .. }))
+                });
+                if !boxed {
+                    return Err(failed(format!(
+                        "fall.soles[{i}]: link \"{s}\" has no box collision shape (a sole's box corners make the \
+                         support polygon)"
+                    )));
+                }
             }
+        }
+        if model.joints().is_empty() {
+            return Err(failed(format!(
+                "urdf: the robot \"{}\" has no actuated joint (every joint is fixed or a mimic): nothing to move",
+                model.name()
+            )));
         }
         if let Some(name) = config.servo.joints.keys().find(|n| !model.is_servoed(n)) {
             return Err(failed(format!(

@@ -199,6 +199,12 @@ fn constraint_keys(c: &ConstraintConfig, path: &str) -> Result<(), ParamError> {
             format!("must name two links, got {}", c.links.len()),
         ));
     }
+    if needs.contains(&"links") && c.links[0] == c.links[1] {
+        return Err(ParamError::new(
+            &join(path, "links"),
+            format!("must name two different links, got \"{}\" twice", c.links[0]),
+        ));
+    }
     for (key, v) in [("axis", c.axis), ("direction", c.direction)] {
         if v.is_some_and(|v| v.iter().map(|x| x * x).sum::<f64>() < 1e-12) {
             return Err(ParamError::new(&join(path, key), "must not be the zero vector"));
