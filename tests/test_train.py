@@ -135,8 +135,12 @@ def test_a_saved_policy_loads_acts_and_rolls_out_the_same(arms_model: GPLVM, tmp
     # The greedy step: act() moves the encoded posture by one action and decodes it.
     target = policy.act(posture)
     assert target.shape == (4,) and np.isfinite(target).all()
-    with pytest.raises(ValueError, match=r"posture: expected shape \(4,\), got \(3,\)"):
+    with pytest.raises(ValueError, match=r"posture: expected the 4 finite joint positions .*got shape \(3,\)"):
         policy.act(posture[:3])
+    with pytest.raises(ValueError, match=r"got shape \(2, 4\)"):  # said "dimensionality mismatch: from=2, to=1"
+        policy.act(np.stack([posture, posture]))
+    with pytest.raises(ValueError, match=r"got shape \(4,\) with NaN or inf"):
+        policy.act(np.where(np.arange(4) == 1, np.nan, posture))
 
 
 def test_rollouts_start_where_the_tests_start_and_share_their_starts(arms_model: GPLVM) -> None:

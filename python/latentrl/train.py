@@ -102,7 +102,12 @@ class LatentPolicy:
     def act(self, posture: Any, trial: int = 0) -> NDArray[np.float64]:
         """The next servo target (D,) for the reached `posture` (D,): encoded, one greedy latent
         step of trial `trial`'s policy (clamped into the latent box), decoded."""
-        target, _, _ = self._policy(trial).act(np.ascontiguousarray(posture, dtype=np.float64))
+        reached = np.ascontiguousarray(posture, dtype=np.float64)
+        joints = self.task.joint_names
+        if reached.shape != (len(joints),) or not np.isfinite(reached).all():
+            raise ValueError(f"posture: expected the {len(joints)} finite joint positions {list(joints)}, "
+                             f"got shape {reached.shape}" + ("" if np.isfinite(reached).all() else " with NaN or inf"))
+        target, _, _ = self._policy(trial).act(reached)
         return np.asarray(target)
 
     def value(self, z: Any, trial: int = 0) -> NDArray[np.float64]:
