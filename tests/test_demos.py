@@ -101,6 +101,8 @@ def write(tmp_path, name, text):
         ("d.csv", "a,b\n1,2\n3\n", r"line 3 \(posture 1\): 1 values, expected 2"),
         ("d.csv", "a,b\n1,2\n3,x\n", r"line 3 \(posture 1\), joint 'b': 'x' is not a number"),
         ("d.csv", "a,b\n1,2\n3,0_5\n", r"line 3 \(posture 1\), joint 'b': '0_5' is not a number"),  # float() reads 5
+        ("d.csv", "1,2\n3,4\n", "line 1 holds numbers, not joint names: the first row must name the joints"),
+        ("d.csv", "# rec\n1,2\n3,4\n", "line 2 holds numbers, not joint names"),
         ("d.csv", "a;b\n1;2\n", "line 1 is one column, 'a;b': the file is separated by ';', not by commas"),
         ("d.csv", "a\tb\n1\t2\n", "separated by '\\\\t', not by commas"),
         ("d.csv", "a,b\n1,2\n3,nan\n", "posture 1, joint 'b': non-finite value nan"),
@@ -207,3 +209,18 @@ def test_a_csv_that_is_not_utf8_is_refused_naming_its_line(tmp_path):
     (tmp_path / "bom.csv").write_bytes(b"\xef\xbb\xbf" + text.encode())
     demos = load_demos(tmp_path / "bom.csv")
     assert demos.joint_names == ("a", "b") and demos.postures.tolist() == [[0.1, 0.2], [0.3, 0.4]]
+
+
+def test_a_recorders_comments_above_the_header_are_skipped(tmp_path):
+    """A '# comment' first line was taken for the header: "line 2 (posture 0): 3 values, expected 1"."""
+    (tmp_path / "d.csv").write_text("# recorded 2026-12-06\n  # arm 2\na,b,c\n0.1,0.2,0.3\n0.4,0.5,0.6\n")
+    demos = load_demos(tmp_path / "d.csv")
+    assert demos.joint_names == ("a", "b", "c")
+    np.testing.assert_array_equal(demos.postures, [[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]])
+
+
+def test_max_postures_below_what_a_fit_needs_is_named(tmp_path):
+    """It said "demos.csv: 2 postures, expected at least 3", blaming the file."""
+    save_demos(Demonstrations(np.arange(12.0).reshape(4, 3), ("a", "b", "c")), tmp_path / "d.csv")
+    with pytest.raises(ValueError, match=r"max_postures \(--max-postures\) = 2 keeps fewer postures than the 3"):
+        load_demos(tmp_path / "d.csv", max_postures=2, min_postures=3)

@@ -102,6 +102,14 @@ def _number(cell: Any, where: str) -> float:
     raise ValueError(f"{where}: {cell!r} is not a number")
 
 
+def _is_number(text: str) -> bool:
+    try:
+        _number(text, "")
+    except ValueError:
+        return False
+    return True
+
+
 def _table(rows: Sequence[tuple[str, Sequence[Any]]], names: Sequence[str]) -> NDArray[np.float64]:
     """(label, cells) rows → (N, D) floats; ragged rows and non-numbers named by label and joint."""
     values = np.empty((len(rows), len(names)))
@@ -120,10 +128,14 @@ def _read_csv(path: Path) -> Demonstrations:
         return fast
     reader = csv.reader(io.StringIO(text, newline=""))
     lines = [(reader.line_num, row) for row in reader if row]
+    while lines and lines[0][1][0].lstrip().startswith("#"):  # a recorder's comments above the header
+        lines.pop(0)
     if not lines:
         raise ValueError("empty file (no header row)")
     (_, header), body = lines[0], lines[1:]
     names = [name.strip() for name in header]
+    if all(_is_number(name) for name in names):
+        raise ValueError(f"line {lines[0][0]} holds numbers, not joint names: the first row must name the joints")
     other = next((sep for sep in (";", "\t", "|") if len(names) == 1 and sep in names[0]), None)
     if other is not None:
         raise ValueError(f"line 1 is one column, {names[0]!r}: the file is separated by {other!r}, not by commas")
@@ -136,8 +148,10 @@ def _numbers_below_header(text: str) -> Demonstrations | None:
     rows of 7 joints in 3.5 s, not 19); None for anything else, which `_read_csv` reads cell by
     cell (and names the line, the posture and the joint of what is wrong)."""
     header, _, body = text.partition("\n")
+    if header.lstrip().startswith("#"):
+        return None  # comments above the header: the cell-by-cell reader skips them
     names = next(csv.reader([header]), [])
-    if not names or not body or body.isspace():  # isspace, not strip: no copy of a large body
+    if not names or not body or body.isspace() or all(_is_number(name) for name in names):  # isspace, not strip: no copy of a large body
         return None
     try:
         values = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2, dtype=np.float64)
@@ -273,6 +287,9 @@ def load_demos(
     path = Path(path)
     if max_postures is not None and not (isinstance(max_postures, int) and max_postures >= 1):
         raise ValueError(f"max_postures must be an int >= 1 or None, got {max_postures!r}")
+    if max_postures is not None and max_postures < min_postures:
+        raise ValueError(f"max_postures (--max-postures) = {max_postures} keeps fewer postures than the "
+                         f"{min_postures} a fit needs")
     kind = recording_kind(path)
     if kind is None:
         if key is not None or joint_names is not None:
