@@ -256,7 +256,7 @@ impl Learner {
 
     /// [`Self::start`], giving up with [`CoreError::Cancelled`] once `cancel` is set (read
     /// before every draw: `max_start_draws` may be 10⁹).
-    fn start_unless<P: Plant, R: Rng + ?Sized>(
+    pub(crate) fn start_unless<P: Plant, R: Rng + ?Sized>(
         &self,
         plant: &mut P,
         space: &StateSpace<'_>,

@@ -316,12 +316,8 @@ where
         let mut tester = template(options.first_trial).clone();
         tester.set_phase(Phase::Test);
         let mut scratch = tester.scratch(space, probe.posture_dim());
-        tester.start(
-            &mut probe,
-            space,
-            &mut trial_rng(options.base_seed, options.first_trial),
-            &mut scratch,
-        )?;
+        let mut rng = trial_rng(options.base_seed, options.first_trial);
+        tester.start_unless(&mut probe, space, &mut rng, &mut scratch, cancel)?; // Ctrl-C: 10⁹ draws may be allowed
     }
     drop(probe);
     let trials = options.first_trial..options.first_trial + options.n_trials;
