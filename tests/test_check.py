@@ -135,6 +135,8 @@ def test_a_dataframe_is_matched_to_the_joints_by_name(glass):
         check(task, holed, model)
     with pytest.raises(TypeError, match="fitted latentrl.GPLVM"):
         check(task, demos, GPLVM())
+    with pytest.raises(ValueError, match=r"run.latent_margin must be a finite number >= 0, got -1"):
+        check(task, demos, model, latent_margin=-1)
 
 
 def latentrl(*args):

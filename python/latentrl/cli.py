@@ -39,7 +39,7 @@ def _check_inputs(args: object) -> None:
     """Every path a command reads exists: named as the user gave it, before any work."""
     for name, label in INPUTS.items():
         path = getattr(args, name, None)
-        if isinstance(path, Path) and not path.exists():
+        if isinstance(path, Path) and not path.exists() and not path.is_symlink():  # a link: its reader says how it fails
             given = "demos" if getattr(args, "command", None) == "fit" and name == "demos" else label  # fit's is positional
             raise ValueError(f"{given} {path}: no such file or directory")
 
@@ -52,12 +52,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
     args = build_parser().parse_args(argv)
     try:
-        _check_inputs(args)
         out = getattr(args, "out", None)
         if out is not None:
             _check_writable(out, file=args.command in ("fit", "replay"))
         if getattr(args, "rerun", None) is not None:
             _check_writable(args.rerun, file=True)
+        _check_inputs(args)
         return COMMANDS[args.command](args)
     except (ValueError, OSError) as err:
         print(f"latentrl: error: {err}", file=sys.stderr)
