@@ -317,7 +317,11 @@ where
         tester.set_phase(Phase::Test);
         let mut scratch = tester.scratch(space, probe.posture_dim());
         let mut rng = trial_rng(options.base_seed, options.first_trial);
-        tester.start_unless(&mut probe, space, &mut rng, &mut scratch, cancel)?; // Ctrl-C: 10⁹ draws may be allowed
+        // Polls Ctrl-C (10⁹ draws may be allowed); cancelled, the trials below return unfinished.
+        match tester.start_unless(&mut probe, space, &mut rng, &mut scratch, cancel) {
+            Ok(()) | Err(CoreError::Cancelled) => {}
+            Err(e) => return Err(e),
+        }
     }
     drop(probe);
     let trials = options.first_trial..options.first_trial + options.n_trials;
