@@ -119,15 +119,15 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     as `train` fits); `latent_margin`: the box's margin (default: the task's `[run]`, else
     `TrainPreset`'s)."""
     from latentrl.derive import SPACING, applied, derive, even_twin
-    from latentrl.gplvm import GPLVM
+    from latentrl.gplvm import GPLVM, check_fitted_gplvm
     from latentrl.run_settings import TrainPreset, latent_box, with_task_run
     from latentrl.task_schema import check_run
 
     postures = task.postures_of(demos)
     if latent_margin is not None:
         check_run({"latent_margin": latent_margin})  # its one rule, named as run.latent_margin
-    if model is not None and (not isinstance(model, GPLVM) or not hasattr(model, "decoder_")):
-        raise TypeError(f"model must be a fitted latentrl.GPLVM, got {model!r}")
+    if model is not None:
+        check_fitted_gplvm(model)
     preset = with_task_run(TrainPreset(), task)
     even: Callable[[], Any] | None = None
     if model is None:  # fitted as `latentrl train` fits, its latent spacing derived as there

@@ -468,6 +468,12 @@ class GPLVM(Estimator):
         return self.decoder_.predict(as_matrix("Z", Z, n_cols=self._n_features_out))[1]
 
 
+def check_fitted_gplvm(model: Any) -> None:
+    """TypeError unless `model` is a fitted GPLVM: the model a latent run (`check`, training) maps with."""
+    if not isinstance(model, GPLVM) or not hasattr(model, "decoder_"):
+        raise TypeError(f"model must be a fitted latentrl.GPLVM, got {model!r}")
+
+
 def sparse_first_stage(n: int) -> NDArray[np.intp]:
     """The postures of a sparse fit's first stage: all `n`, or `SPARSE_FIRST_STAGE` evenly spaced
     ones (the first, the last and every (n − 1)/(SPARSE_FIRST_STAGE − 1)-th between)."""

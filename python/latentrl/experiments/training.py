@@ -20,7 +20,7 @@ from latentrl._files import MAX_MESH_BYTES, MAX_TASK_FILE_BYTES, MAX_URDF_BYTES,
 from latentrl.demos import load_demos
 from latentrl.recorded import recording_kind
 from latentrl.recorded.options import DemoOptions
-from latentrl.gplvm import GPLVM
+from latentrl.gplvm import GPLVM, check_fitted_gplvm
 from latentrl.task import SHIPPED, Task, end_reasons
 from latentrl.run_settings import TrainPreset, latent_box, with_overrides, with_task_run
 from latentrl.train import RECORD, LatentPolicy
@@ -275,8 +275,7 @@ def train_latent_policy(
 
     if preset not in ("quick", "paper"):
         raise ValueError(f"preset must be 'quick' or 'paper', got {preset!r}")
-    if not isinstance(model, GPLVM) or not hasattr(model, "decoder_"):
-        raise TypeError(f"model must be a fitted latentrl.GPLVM, got {model!r}")
+    check_fitted_gplvm(model)
     task, chosen = _preset_for(task, preset == "quick", {**fields, **(overrides or {})})
     if model.n_features_in_ != len(task.joint_names):
         raise ValueError(
