@@ -156,17 +156,7 @@ class Task:
         """The native plant of this task (home posture: demo `episode.start_demo` of `demos`); a
         home posture the robot cannot take is named by its row."""
         rows = None if demos is None else np.ascontiguousarray(demos, dtype=np.float64)
-        try:
-            return _native.TaskPlant(self._native, rows)
-        except ValueError as err:
-            row = self.to_dict()["episode"]["start_demo"]
-            if rows is None or rows.ndim != 2 or rows.shape[1] != len(self.joint_names) or not 0 <= row < len(rows):
-                raise  # no such row or posture: the native message says so
-            try:
-                _native.TaskPlant(self._native, None)
-            except ValueError:
-                raise err from None  # not the home posture's fault
-            raise type(err)(f"demos row {row} (the home posture, episode.start_demo): {err}") from err
+        return _native.TaskPlant(self._native, rows)
 
     def check_joints(self, joint_names: tuple[str, ...] | list[str], where: str) -> None:
         """ValueError naming `where` unless `joint_names` are this robot's actuated joints in order."""

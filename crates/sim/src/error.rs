@@ -116,6 +116,15 @@ pub enum SimError {
         /// Number of obstacles in the world.
         count: usize,
     },
+    /// The home posture, demonstration `episode.start_demo`, that the robot cannot take (a
+    /// joint outside its limits, …), where the robot stands at a neutral posture.
+    #[error("demos row {row} (the home posture, episode.start_demo): {source}")]
+    HomePosture {
+        /// The demonstration's row (from 0).
+        row: usize,
+        /// Why the robot cannot take it.
+        source: Box<SimError>,
+    },
     /// Demonstration columns that do not fit the robot's joints.
     #[error("demo columns: {reason}")]
     DemoColumns {
@@ -129,6 +138,7 @@ impl SimError {
     pub fn kind(&self) -> ErrorKind {
         match self {
             Self::Input(core) => core.kind(),
+            Self::HomePosture { source, .. } => source.kind(),
             _ => ErrorKind::Input,
         }
     }

@@ -331,3 +331,24 @@ fn classify_gives_one_posture_per_column() {
     p.reset(&b);
     assert_eq!(c.effectors.column(1).as_slice(), p.effectors());
 }
+
+#[test]
+fn a_home_posture_the_robot_cannot_take_is_named_by_its_demo_row() {
+    let task = std::sync::Arc::new(common::task("two_arms"));
+    let joints = task.model().joints();
+    let upper = joints[1].upper;
+    let good: Vec<f64> = joints.iter().map(|j| 0.5 * (j.lower + j.upper)).collect();
+    let mut bad = good.clone();
+    bad[1] = upper + 1.0;
+    match TaskPlant::new(task.clone(), Some(&[bad.clone(), good.clone()])) {
+        Err(sim::SimError::HomePosture { row: 0, source }) => {
+            assert!(source.to_string().contains("position"), "{source}")
+        }
+        other => panic!("expected the home posture named, got {:?}", other.err()),
+    }
+    // Another start demo is the home posture; a bad row elsewhere is the survey's to find.
+    let mut config = task.config().clone();
+    config.episode.start_demo = 1;
+    let second = Task::new(config, task.model().clone(), "test").unwrap();
+    assert!(TaskPlant::new(std::sync::Arc::new(second), Some(&[bad, good])).is_ok());
+}

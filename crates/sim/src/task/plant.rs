@@ -106,12 +106,7 @@ impl TaskPlant {
                     "episode.start = \"demo\" needs the demonstrations".to_string(),
                 ));
             }
-            None => task
-                .model()
-                .joints()
-                .iter()
-                .map(|j| 0.0_f64.clamp(j.lower, j.upper))
-                .collect(),
+            None => neutral_posture(&task),
         };
         let rebuild = config.root == RootMode::Floating
             || config
@@ -185,7 +180,16 @@ impl TaskPlant {
             plant.world.fall_status(fall)?;
         }
         let home = plant.home.clone();
-        plant.stand(&home)?;
+        if let Err(err) = plant.stand(&home) {
+            // Named as the home posture's fault only where the robot stands at a neutral one.
+            return Err(match demos {
+                Some(_) if plant.stand(&neutral_posture(&task)).is_ok() => SimError::HomePosture {
+                    row: start.start_demo,
+                    source: Box::new(err),
+                },
+                _ => err,
+            });
+        }
         Ok(plant)
     }
 
@@ -467,6 +471,15 @@ impl TaskPlant {
         let axis = self.task.config().waypoint.as_ref().map_or(1, |w| w.axis.index());
         self.effectors.chunks_exact(3).all(|h| test(h[axis]))
     }
+}
+
+/// Every joint at 0, clamped into its limits: the home posture without demonstrations.
+fn neutral_posture(task: &Task) -> Vec<f64> {
+    task.model()
+        .joints()
+        .iter()
+        .map(|j| 0.0_f64.clamp(j.lower, j.upper))
+        .collect()
 }
 
 fn task_error(task: &Task, reason: String) -> SimError {
