@@ -168,6 +168,20 @@ def test_bad_task_files_are_one_line_and_write_nothing(tmp_path, edit, message):
     assert not (tmp_path / "out").exists()
 
 
+def test_a_test_start_no_start_meets_fails_after_the_fit_and_leaves_nothing(tmp_path):
+    """The test-start rule is tried before training; a new run that saved no trial left its
+    gplvm.npz and .lock behind (session 13's sweep)."""
+    out = tmp_path / "out"
+    result = latentrl(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--quick",
+                       "--trials", "1", "--episodes", "2", "--no-progress", "--out", str(out),
+                       "--episode.test-start", "below_waypoint", "--waypoint.below", "-1000",
+                       "--episode.max-start-draws", "100"])
+    assert result.returncode == 1, result.stderr
+    assert "no start of a frozen test episode in 100 draws, tried before training" in result.stderr, result.stderr
+    assert "episode.test_start" in result.stderr and "Traceback" not in result.stderr
+    assert not out.exists()
+
+
 def test_demos_of_another_robot_are_refused_by_column(tmp_path):
     csv = tmp_path / "demos.csv"
     csv.write_text("shoulder,elbow,knee\n0.1,0.2,0.3\n0.2,0.3,0.4\n0.3,0.1,0.2\n")

@@ -66,6 +66,16 @@ pub enum CoreError {
         /// How many starts were drawn.
         draws: usize,
     },
+    /// No start of a frozen test episode was found, tried before any training.
+    #[error(
+        "no start of a frozen test episode in {draws} draws, tried before training: every drawn \
+         start was refused by the plant's test-start rule (a task's episode.test_start), the start \
+         distribution, the box or variance gating; check those, or run without test episodes"
+    )]
+    NoTestStart {
+        /// How many starts were drawn.
+        draws: usize,
+    },
     /// The caller's cancel flag was set during an episode or its start draws (Ctrl-C).
     #[error("cancelled")]
     Cancelled,
@@ -117,6 +127,7 @@ impl CoreError {
             | Self::Empty { .. }
             | Self::InvalidParameter { .. }
             | Self::NoValidStart { .. }
+            | Self::NoTestStart { .. }
             | Self::Param(_)
             | Self::Plant { .. }
             | Self::Argument(_)

@@ -278,7 +278,8 @@ pub struct TrialResult {
 /// `cancel` is read before every step and start draw: once set, every trial stops and reports
 /// `finished = false`. `done` is incremented after every episode, test episodes included
 /// (progress: `n_trials × (episodes + test_episodes)` in all).
-/// Inputs are checked once, up front; the only error past that point is
+/// Inputs are checked once, up front, with one test episode's start when there are test
+/// episodes ([`CoreError::NoTestStart`]); the only error past that point is
 /// [`CoreError::NoValidStart`].
 pub fn run_trials<P, F>(
     templates: &[Learner],
@@ -320,6 +321,7 @@ where
         // Polls Ctrl-C (10⁹ draws may be allowed); cancelled, the trials below return unfinished.
         match tester.start_unless(&mut probe, space, &mut rng, &mut scratch, cancel) {
             Ok(()) | Err(CoreError::Cancelled) => {}
+            Err(CoreError::NoValidStart { draws }) => return Err(CoreError::NoTestStart { draws }),
             Err(e) => return Err(e),
         }
     }
@@ -704,7 +706,7 @@ mod tests {
         };
         let one = std::slice::from_ref(&template);
         let err = run_trials(one, &StateSpace::Full, plant, &options, &cancel, &done).unwrap_err();
-        assert!(matches!(err, CoreError::NoValidStart { draws: 50 }), "{err}");
+        assert!(matches!(err, CoreError::NoTestStart { draws: 50 }), "{err}");
         assert_eq!(done.load(Ordering::Relaxed), 0, "no training episode ran");
     }
 

@@ -177,7 +177,7 @@ def _run_rl(preset: Preset, out: Path, setup: Callable[[Any, Path], Setup],
                 _save(meta_path, arrays_path, meta, arrays)
         finally:
             bar.close()
-    except OSError:  # a full disk, a folder gone read-only: a new run that saved no trial leaves nothing
+    except BaseException:  # a full disk, a refused start, Ctrl-C: a new run that saved no trial leaves nothing
         if fresh and not meta_path.exists():
             folder.model_path.unlink(missing_ok=True)
             arrays_path.unlink(missing_ok=True)
