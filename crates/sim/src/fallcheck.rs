@@ -35,10 +35,7 @@ impl FallCheckConfig {
     /// (its two links are the hands, its value the grip width), holding each target `hold` s.
     pub fn for_task(task: &Task, hold: f64) -> Result<Self> {
         let config = task.config();
-        let failed = |reason: &str| SimError::Task {
-            origin: task.origin().to_string(),
-            reason: reason.to_string(),
-        };
+        let failed = |reason: &str| task.error(reason);
         let rule = config
             .fall
             .as_ref()

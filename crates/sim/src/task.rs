@@ -172,6 +172,14 @@ impl Task {
         &self.origin
     }
 
+    /// A [`SimError::Task`] of this task: `reason`, after where the task came from.
+    pub fn error(&self, reason: impl Into<String>) -> SimError {
+        SimError::Task {
+            origin: self.origin.clone(),
+            reason: reason.into(),
+        }
+    }
+
     /// The world every episode runs in.
     pub fn world_config(&self) -> WorldConfig {
         WorldConfig {

@@ -81,30 +81,21 @@ impl TaskPlant {
         let home = match demos {
             Some(rows) => {
                 if let Some((i, row)) = rows.iter().enumerate().find(|(_, r)| r.len() != n) {
-                    return Err(task_error(
-                        &task,
-                        format!(
-                            "demonstration {i} has {} values, the robot {n} actuated joints",
-                            row.len()
-                        ),
-                    ));
+                    return Err(task.error(format!(
+                        "demonstration {i} has {} values, the robot {n} actuated joints",
+                        row.len()
+                    )));
                 }
                 rows.get(start.start_demo).cloned().ok_or_else(|| {
-                    task_error(
-                        &task,
-                        format!(
-                            "episode.start_demo = {} is not a row of the {} demonstrations",
-                            start.start_demo,
-                            rows.len()
-                        ),
-                    )
+                    task.error(format!(
+                        "episode.start_demo = {} is not a row of the {} demonstrations",
+                        start.start_demo,
+                        rows.len()
+                    ))
                 })?
             }
             None if start.start == super::StartRule::Demo => {
-                return Err(task_error(
-                    &task,
-                    "episode.start = \"demo\" needs the demonstrations".to_string(),
-                ));
+                return Err(task.error("episode.start = \"demo\" needs the demonstrations"));
             }
             None => neutral_posture(&task),
         };
@@ -400,12 +391,10 @@ impl TaskPlant {
     /// The static support margin now (m; the fall rule's soles): how far inside the support
     /// polygon the centre of mass lies, negative outside.
     pub fn support_margin(&self) -> Result<f64> {
-        let fall = self.fall.as_ref().ok_or_else(|| {
-            task_error(
-                &self.task,
-                "the support margin needs a [fall] table (its soles)".to_string(),
-            )
-        })?;
+        let fall = self
+            .fall
+            .as_ref()
+            .ok_or_else(|| self.task.error("the support margin needs a [fall] table (its soles)"))?;
         support_margin(&self.world, &fall.soles)
     }
 
@@ -480,13 +469,6 @@ fn neutral_posture(task: &Task) -> Vec<f64> {
         .iter()
         .map(|j| 0.0_f64.clamp(j.lower, j.upper))
         .collect()
-}
-
-fn task_error(task: &Task, reason: String) -> SimError {
-    SimError::Task {
-        origin: task.origin().to_string(),
-        reason,
-    }
 }
 
 impl Plant for TaskPlant {

@@ -29,7 +29,7 @@ use latent_core::{Learner, Plant, ResultArray};
 use rayon::prelude::*;
 
 use super::{Task, TaskPlant};
-use crate::error::{Result, SimError};
+use crate::error::Result;
 
 /// Points a grid holds at most by default: ≈ 10 s of resets on two cores for a floating robot.
 pub const DEFAULT_MAX_POINTS: usize = 20_000;
@@ -296,7 +296,7 @@ impl LearnerGrid {
     /// The grid over `[low, high]` at `task`'s learner step with at most `max_points` points.
     pub fn new(task: &Task, low: &[f64], high: &[f64], max_points: usize) -> Result<Self> {
         let learner = Learner::new(&task.config().learner, task.episode_rules(), low, high)
-            .map_err(|e| task_error(task, e.to_string()))?;
+            .map_err(|e| task.error(e.to_string()))?;
         let d = low.len();
         // The learner's step per dimension: its largest move along each axis.
         let displacements = learner.displacements();
@@ -306,15 +306,12 @@ impl LearnerGrid {
         let fits = |k: usize| (high[k] - low[k]) / (MAX_STRIDE as f64 * step[k]) + 1.0;
         if (0..d).map(fits).product::<f64>() > max_points.max(1) as f64 {
             let steps = (0..d).map(|k| (high[k] - low[k]) / step[k]).fold(0.0, f64::max);
-            return Err(task_error(
-                task,
-                format!(
-                    "learner.step = {:e}: the latent box is {steps:.3e} learner steps wide, more than a survey \
+            return Err(task.error(format!(
+                "learner.step = {:e}: the latent box is {steps:.3e} learner steps wide, more than a survey \
                      samples ({max_points} points at most {MAX_STRIDE} learner steps apart); give a larger \
                      learner.step",
-                    task.config().learner.step
-                ),
-            ));
+                task.config().learner.step
+            )));
         }
         let moves = displacements
             .chunks_exact(d)
@@ -395,15 +392,12 @@ fn survey(
     let grid = &at.grid;
     let d = grid.shape().len();
     if decoder.input_dim() != d || decoder.output_dim() != task.model().joints().len() {
-        return Err(task_error(
-            task,
-            format!(
-                "the decoder maps {} → {} values; the survey needs {d} → {} (the robot's joints)",
-                decoder.input_dim(),
-                decoder.output_dim(),
-                task.model().joints().len()
-            ),
-        ));
+        return Err(task.error(format!(
+            "the decoder maps {} → {} values; the survey needs {d} → {} (the robot's joints)",
+            decoder.input_dim(),
+            decoder.output_dim(),
+            task.model().joints().len()
+        )));
     }
     let n = grid.len();
     let e = 3 * task.config().effectors.len();
@@ -413,9 +407,9 @@ fn survey(
         .map_init(
             || TaskPlant::new(Arc::clone(task), demos),
             |plant, &start| {
-                let plant = plant.as_mut().map_err(|err| task_error(task, err.to_string()))?;
+                let plant = plant.as_mut().map_err(|err| task.error(err.to_string()))?;
                 if cancel.load(Ordering::Relaxed) {
-                    return Err(task_error(task, "the survey was cancelled".to_string()));
+                    return Err(task.error("the survey was cancelled"));
                 }
                 let (mut z, mut q) = (vec![0.0; d], vec![0.0; decoder.output_dim()]);
                 let mut scratch = decoder.scratch();
@@ -423,7 +417,7 @@ fn survey(
                 let mut part = Part::default();
                 for i in start..end {
                     if physics && cancel.load(Ordering::Relaxed) {
-                        return Err(task_error(task, "the survey was cancelled".to_string()));
+                        return Err(task.error("the survey was cancelled"));
                     }
                     grid.point(i, &mut z);
                     decoder.mean_into(&z, &mut q, &mut scratch);
@@ -528,9 +522,9 @@ fn refine(
         .map_init(
             || TaskPlant::new(Arc::clone(task), demos),
             |plant, &cell| {
-                let plant = plant.as_mut().map_err(|err| task_error(task, err.to_string()))?;
+                let plant = plant.as_mut().map_err(|err| task.error(err.to_string()))?;
                 if cancel.load(Ordering::Relaxed) {
-                    return Err(task_error(task, "the survey was cancelled".to_string()));
+                    return Err(task.error("the survey was cancelled"));
                 }
                 let mut q = vec![0.0; decoder.output_dim()];
                 let mut scratch = decoder.scratch();
@@ -648,13 +642,6 @@ struct Part {
     distance: Vec<f64>,
     reached: Vec<bool>,
     effectors: Vec<f64>,
-}
-
-fn task_error(task: &Task, reason: String) -> SimError {
-    SimError::Task {
-        origin: task.origin().to_string(),
-        reason,
-    }
 }
 
 #[cfg(test)]
