@@ -210,14 +210,16 @@ pub(crate) fn scan(xml: &str, origin: &str) -> Result<Scan> {
     }
     let mut out = Scan::default();
     let mut edits: Vec<(usize, usize, String)> = Vec::new();
-    let mut stack: Vec<&str> = Vec::new();
+    // The open elements: name and line.
+    let mut stack: Vec<(&str, usize)> = Vec::new();
     // The joint being read: (name, type, whether its <limit> gave lower or upper).
     let mut joint: Option<(String, String, bool)> = None;
     // Start of an element dropped from a <geometry>, and its depth.
     let mut dropping: Option<(usize, usize)> = None;
     for tag in &all {
         let slash = if tag.self_closing { "/" } else { "" };
-        let element = format!("<{}{}{slash}>", tag.name, tag.attrs.trim_end());
+        let close = if tag.closing { "/" } else { "" };
+        let element = format!("<{close}{}{}{slash}>", tag.name, tag.attrs.trim_end());
         let at = |what: String| refuse(format!("line {}, {element}: {what}", tag.line));
         if tag.name.starts_with("xacro:") {
             return Err(at(RUN_XACRO.to_string()));
@@ -229,7 +231,15 @@ pub(crate) fn scan(xml: &str, origin: &str) -> Result<Scan> {
                 edits.push((start, tag.end, String::new()));
                 dropping = None;
             }
-            stack.pop();
+            match stack.pop() {
+                Some((open, _)) if open == tag.name => {}
+                Some((open, line)) => {
+                    return Err(at(format!(
+                        "closes <{open}>, opened on line {line}: the tags are not nested"
+                    )));
+                }
+                None => return Err(at("closes no open element".to_string())),
+            }
             if tag.name == "joint"
                 && let Some((name, kind, ranged)) = joint.take()
                 && (kind == "revolute" || kind == "prismatic")
@@ -246,7 +256,7 @@ pub(crate) fn scan(xml: &str, origin: &str) -> Result<Scan> {
         let part = if stack.len() == 1 {
             Some(&tag.name)
         } else {
-            stack.get(1)
+            stack.get(1).map(|(name, _)| name)
         };
         let read = matches!(part, Some(&"link" | &"joint" | &"material"));
         for (name, v, from, to) in attrs.iter().filter(|_| read) {
@@ -299,7 +309,7 @@ pub(crate) fn scan(xml: &str, origin: &str) -> Result<Scan> {
             joint = Some((name, value("type").unwrap_or("").to_string(), false));
         }
         if tag.name == "limit"
-            && stack.last() == Some(&"joint")
+            && stack.last().map(|t| t.0) == Some("joint")
             && let Some(j) = joint.as_mut()
         {
             if value("effort").is_none() || value("velocity").is_none() {
@@ -309,7 +319,7 @@ pub(crate) fn scan(xml: &str, origin: &str) -> Result<Scan> {
             }
             j.2 = value("lower").is_some() || value("upper").is_some();
         }
-        if dropping.is_none() && stack.last() == Some(&"geometry") && !SHAPES.contains(&tag.name) {
+        if dropping.is_none() && stack.last().map(|t| t.0) == Some("geometry") && !SHAPES.contains(&tag.name) {
             out.warnings.push(format!(
                 "line {}: <{}> inside <geometry> of link {:?} ignored (a <geometry> holds one shape)",
                 tag.line,
@@ -323,11 +333,14 @@ pub(crate) fn scan(xml: &str, origin: &str) -> Result<Scan> {
             }
         }
         if !tag.self_closing {
-            stack.push(tag.name);
+            stack.push((tag.name, tag.line));
         }
         if tag.self_closing && stack.len() == 1 && tag.name == "joint" {
             joint = None;
         }
+    }
+    if let Some((open, line)) = stack.last() {
+        return Err(refuse(format!("line {line}: <{open}> is never closed")));
     }
     edits.sort_by_key(|e| e.0);
     let mut text_out = String::with_capacity(text.len());
@@ -395,6 +408,16 @@ mod tests {
         );
         let r = reason("<robot>\n<joint name='j'><origin rpy='1 2 3 4'/></joint></robot>");
         assert!(r.contains("line 2") && r.contains("rpy: 4 numbers, expected 3"), "{r}");
+    }
+
+    #[test]
+    fn names_the_line_of_tags_that_do_not_nest() {
+        let r = reason("<robot>\n<joint name='j' type='fixed'>\n</joitn></robot>");
+        assert_eq!(r, "line 3, </joitn>: closes <joint>, opened on line 2: the tags are not nested");
+        let r = reason("<robot>\n<link name='l'>\n</robot>");
+        assert!(r.starts_with("line 3, </robot>: closes <link>, opened on line 2"), "{r}");
+        assert_eq!(reason("<robot>\n<link name='l'>"), "line 2: <link> is never closed");
+        assert_eq!(reason("<robot></robot>\n</link>"), "line 2, </link>: closes no open element");
     }
 
     #[test]
