@@ -339,14 +339,21 @@ def test_every_task_key_the_advice_names_exists():
 
 
 def test_a_home_posture_outside_the_joint_limits_is_named_by_its_row(tmp_path):
-    """The CLI said only `invalid position … for joint "wrist"`, from the survey after the fit."""
+    """The CLI said only `invalid position … for joint "wrist"`, from the survey after the fit. A
+    task whose episodes start at demo `episode.start_demo` names it; one with uniform starts
+    stands the robot elsewhere and reports the rows outside the limits with the rest."""
     urdf = (EXAMPLE / "glass_arm.urdf").read_text()
     assert 'lower="-6.0" upper="6.0"' in urdf
     (tmp_path / "glass_arm.urdf").write_text(urdf.replace('lower="-6.0" upper="6.0"', 'lower="-1.0" upper="1.0"'))
-    (tmp_path / "task.toml").write_text((EXAMPLE / "glass_arm.toml").read_text())
+    text = (EXAMPLE / "glass_arm.toml").read_text()
+    assert 'start = "uniform"' in text
+    (tmp_path / "task.toml").write_text(text.replace('start = "uniform"', 'start = "demo"'))
     said = 'demos row 0 (the home posture, episode.start_demo): invalid position'
     done = latentrl("check", str(tmp_path / "task.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--no-progress")
     assert done.returncode == 1 and f"demos.csv: {said}" in done.stderr and "wrist" in done.stderr, done.stderr
     task = Task.load(tmp_path / "task.toml")
     found = check(task, load_demos(EXAMPLE / "demos.csv").postures).findings[0]
     assert found.verdict == "will not learn" and found.message.startswith(said)
+    (tmp_path / "task.toml").write_text(text)
+    found = check(Task.load(tmp_path / "task.toml"), load_demos(EXAMPLE / "demos.csv").postures).findings[0]
+    assert found.verdict == "warning" and "rows outside the joint limits: rows 0, 1" in found.message, found.message

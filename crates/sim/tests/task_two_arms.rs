@@ -334,21 +334,33 @@ fn classify_gives_one_posture_per_column() {
 
 #[test]
 fn a_home_posture_the_robot_cannot_take_is_named_by_its_demo_row() {
-    let task = std::sync::Arc::new(common::task("two_arms"));
-    let joints = task.model().joints();
-    let upper = joints[1].upper;
+    let shipped = common::task("two_arms");
+    let joints = shipped.model().joints();
     let good: Vec<f64> = joints.iter().map(|j| 0.5 * (j.lower + j.upper)).collect();
     let mut bad = good.clone();
-    bad[1] = upper + 1.0;
-    match TaskPlant::new(task.clone(), Some(&[bad.clone(), good.clone()])) {
+    bad[1] = joints[1].upper + 1.0;
+    let task = |start, start_demo| {
+        let mut config = shipped.config().clone();
+        config.episode.start = start;
+        config.episode.start_demo = start_demo;
+        std::sync::Arc::new(Task::new(config, shipped.model().clone(), "test").unwrap())
+    };
+    let demos = [bad.clone(), good.clone()];
+    match TaskPlant::new(task(sim::task::StartRule::Demo, 0), Some(&demos)) {
         Err(sim::SimError::HomePosture { row: 0, source }) => {
             assert!(source.to_string().contains("position"), "{source}")
         }
         other => panic!("expected the home posture named, got {:?}", other.err()),
     }
     // Another start demo is the home posture; a bad row elsewhere is the survey's to find.
-    let mut config = task.config().clone();
-    config.episode.start_demo = 1;
-    let second = Task::new(config, task.model().clone(), "test").unwrap();
-    assert!(TaskPlant::new(std::sync::Arc::new(second), Some(&[bad, good])).is_ok());
+    assert!(TaskPlant::new(task(sim::task::StartRule::Demo, 1), Some(&demos)).is_ok());
+    // No episode starts at the home posture: the robot stands at a neutral one instead.
+    let plant = TaskPlant::new(task(sim::task::StartRule::Uniform, 0), Some(&demos)).unwrap();
+    assert!(
+        plant
+            .home()
+            .iter()
+            .zip(joints)
+            .all(|(q, j)| *q == 0.0_f64.clamp(j.lower, j.upper))
+    );
 }

@@ -172,14 +172,20 @@ impl TaskPlant {
         }
         let home = plant.home.clone();
         if let Err(err) = plant.stand(&home) {
-            // Named as the home posture's fault only where the robot stands at a neutral one.
-            return Err(match demos {
-                Some(_) if plant.stand(&neutral_posture(&task)).is_ok() => SimError::HomePosture {
+            // The home posture's fault only where the robot stands at a neutral one; no episode
+            // starts there unless `episode.start = "demo"`, so then the robot stands at that one
+            // (and the demos finding of `latentrl check` names the row).
+            let neutral = neutral_posture(&task);
+            if demos.is_none() || plant.stand(&neutral).is_err() {
+                return Err(err);
+            }
+            if start.start == super::StartRule::Demo {
+                return Err(SimError::HomePosture {
                     row: start.start_demo,
                     source: Box::new(err),
-                },
-                _ => err,
-            });
+                });
+            }
+            plant.home = neutral;
         }
         Ok(plant)
     }
@@ -240,7 +246,9 @@ impl TaskPlant {
         &self.effectors
     }
 
-    /// The home posture (the start demonstration, or zeros).
+    /// The home posture: the start demonstration, or every joint at 0 within its limits
+    /// (without demonstrations, or where the robot cannot take that one and no episode starts
+    /// from it).
     pub fn home(&self) -> &[f64] {
         &self.home
     }

@@ -413,11 +413,20 @@ mod tests {
     #[test]
     fn names_the_line_of_tags_that_do_not_nest() {
         let r = reason("<robot>\n<joint name='j' type='fixed'>\n</joitn></robot>");
-        assert_eq!(r, "line 3, </joitn>: closes <joint>, opened on line 2: the tags are not nested");
+        assert_eq!(
+            r,
+            "line 3, </joitn>: closes <joint>, opened on line 2: the tags are not nested"
+        );
         let r = reason("<robot>\n<link name='l'>\n</robot>");
-        assert!(r.starts_with("line 3, </robot>: closes <link>, opened on line 2"), "{r}");
+        assert!(
+            r.starts_with("line 3, </robot>: closes <link>, opened on line 2"),
+            "{r}"
+        );
         assert_eq!(reason("<robot>\n<link name='l'>"), "line 2: <link> is never closed");
-        assert_eq!(reason("<robot></robot>\n</link>"), "line 2, </link>: closes no open element");
+        assert_eq!(
+            reason("<robot></robot>\n</link>"),
+            "line 2, </link>: closes no open element"
+        );
     }
 
     #[test]
