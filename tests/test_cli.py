@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -381,3 +382,24 @@ def test_a_missing_input_or_an_empty_path_is_named_before_any_work(tmp_path):
     assert result.returncode == 1 and "--demos nothere.csv: no such file or directory" in result.stderr, result.stderr
     result = latentrl("train", task, "--demos", demos, "--out", "")
     assert result.returncode == 2 and "argument --out: an empty path" in result.stderr, result.stderr
+
+
+def test_a_costly_exact_fit_says_its_cost_first_in_one_line(tmp_path, monkeypatch, capsys):
+    """The sweep's 5 000-row CSV fitted for minutes without a word: beyond `COSTLY_EXACT_FIT`
+    postures the fit first says what an iteration costs and how to spend less, as a CLI warning."""
+    from latentrl import gplvm
+
+    monkeypatch.setattr(gplvm, "COSTLY_EXACT_FIT", 30)
+    rng = np.random.default_rng(0)
+    demos = tmp_path / "demos.csv"
+    demos.write_text("a,b,c\n" + "\n".join(",".join(f"{v:.6f}" for v in row) for row in rng.uniform(-1, 1, (40, 3))))
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")  # pytest's filter makes warnings errors; a user's shell does not
+        assert main(["fit", str(demos), "--max-iter", "5", "--out", str(tmp_path / "m.npz")]) == 0
+    err = capsys.readouterr().err
+    warned = [line for line in err.splitlines() if "each iteration of an exact GPLVM fit costs" in line]
+    assert len(warned) == 1 and warned[0].startswith("latentrl: warning: X: 40 postures:"), err
+    assert "--max-postures 1000" in warned[0] and "--inducing 256" in warned[0]
+    with pytest.warns(UserWarning, match="40 postures: each iteration"):
+        gplvm.GPLVM(max_iter=2).fit(rng.uniform(-1, 1, (40, 3)))
+    gplvm.GPLVM(max_iter=2).fit(rng.uniform(-1, 1, (30, 3)))  # at the bound: no warning (pytest's -W error)

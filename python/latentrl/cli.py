@@ -4,10 +4,13 @@ exit codes (`latentrl.cli_parser.DESCRIPTION` lists them)."""
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from latentrl.cli_commands import COMMANDS
 from latentrl.cli_parser import build_parser
@@ -51,6 +54,19 @@ RECORDING_LIBRARIES = ("pyarrow", "h5py", "rosbags")
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
     args = build_parser().parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_warning
+        return _run(args)
+
+
+def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                  file: Any = None, line: str | None = None) -> None:
+    """A warning as a CLI user reads it: one line, without the source line that raised it."""
+    print(f"latentrl: warning: {message}", file=sys.stderr)
+
+
+def _run(args: argparse.Namespace) -> int:
+    """Runs the command of `args`; an error is one line on stderr and an exit code."""
     try:
         out = getattr(args, "out", None)
         if out is not None:

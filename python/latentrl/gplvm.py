@@ -28,6 +28,15 @@ RESTART_SCALE = 0.5
 #: many evenly spaced postures first, then all (docs/method.md §Sparse GPLVM).
 SPARSE_FIRST_STAGE = 4096
 
+#: Postures beyond which an exact fit first says what one iteration will cost: it grows as N³
+#: (one objective and gradient: 0.27 s at 1 000 postures, 6.3 s at 2 000 on the 2-core machine
+#: of docs/performance.md), and a fit runs up to `max_iter` of them without a word.
+COSTLY_EXACT_FIT = 1000
+
+#: Postures of the timed objective that cost is extrapolated from (by N³: a lower bound, as
+#: larger matrices also leave the CPU's caches).
+COST_SAMPLE = 500
+
 
 class GPLVM(Estimator):
     """Gaussian-process latent variable model with an SE + white-noise kernel (paper Eq. 2).
@@ -247,6 +256,8 @@ class GPLVM(Estimator):
         tol = positive("tol", self.tol)
         self._check_encoder(self.encoder)
 
+        if inducing is None and len(X) > COSTLY_EXACT_FIT:
+            _warn_of_cost(X, d, max_iter)
         pca = PCA(d).fit(X)
         start = pca.transform(X) / (np.sqrt(pca.explained_variance_[0]) or 1.0)
         centred = X - pca.mean_
@@ -531,3 +542,20 @@ def latent_relevance(Z: NDArray[np.float64], theta: NDArray[np.float64]) -> NDAr
     spread = np.linalg.eigvalsh(np.atleast_2d(np.cov(Z, rowvar=False)))
     relevance: NDArray[np.float64] = np.sort(np.maximum(spread, 0.0))[::-1] / theta[1]
     return relevance
+
+
+def _warn_of_cost(X: NDArray[np.float64], d: int, max_iter: int) -> None:
+    """A UserWarning of what an exact fit of `X` costs per iteration here (timed on `COST_SAMPLE`
+    of its postures, extrapolated by N³) and how to spend less, before the fit begins."""
+    import time
+    import warnings
+
+    sample = X[:COST_SAMPLE] - X[:COST_SAMPLE].mean(axis=0)
+    began = time.perf_counter()
+    gplvm_nll_grad(np.random.default_rng(0).standard_normal((len(sample), d)), sample, np.zeros(3))
+    each = (time.perf_counter() - began) * (len(X) / len(sample)) ** 3
+    warnings.warn(f"X: {len(X)} postures: each iteration of an exact GPLVM fit costs at least {each:.2g} s here "
+                  f"(it grows as N³), for up to {max_iter} iterations; keep fewer postures (load_demos(..., "
+                  "max_postures=1000), --max-postures 1000: farthest-point sampling keeps each motion's extremes) "
+                  "or fit the sparse GPLVM (GPLVM(inducing=256), `latentrl fit --inducing 256`, then --model)",
+                  stacklevel=3)
