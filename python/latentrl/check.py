@@ -179,16 +179,32 @@ def demo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
     names = end_reasons()
     broken = {names[c]: np.flatnonzero(codes == c).tolist() for c in np.unique(codes) if c != 0}
     rows = sorted(r for rs in broken.values() for r in rs)
+    wrapped = wrapped_joints(task, demos)
+    wrap = (f"{', '.join(wrapped)}: values on both sides of ±π, as if wrapped into [−π, π]: postures a little "
+            "apart lie 2π apart in the latent space's inputs; unwrap each recording (np.unwrap along its frames) "
+            "and shift it by a multiple of 2π into ±2π") if wrapped else ""
+    if wrapped and not rows:
+        return Finding("demos", "warning", wrap, "unwrap those joints' values", {"joints": wrapped})
     if not rows:
         return Finding("demos", "ok", f"all {len(demos)} rows are admissible postures at rest")
     what = "; ".join(f"{RULE_NAMES.get(n, 'break the ' + n + ' rule')}: rows {_rows(r)}" for n, r in broken.items())
     dropped = len(broken.get("drop", [])) / len(demos)
     verdict = "will not learn" if dropped >= BROKEN_SHARE else "warning"
-    return Finding("demos", verdict, f"{len(rows)} of {len(demos)} rows {what}",
+    return Finding("demos", verdict, f"{len(rows)} of {len(demos)} rows {what}" + (f"; {wrap}" if wrap else ""),
                    "remove or fix those rows: the latent space is built from them, and the task refuses them"
                    + (" (the learner moves on the demos' manifold: most of it breaks the constraint)"
                       if verdict == "will not learn" else ""),
                    {"rows": dict(broken)})
+
+
+def wrapped_joints(task: Task, demos: NDArray[np.float64]) -> list[str]:
+    """The unlimited (continuous) joints whose values, shifted by 2π where negative, span at least
+    π less than they do: their values lie near both +π and −π, wrapped into [−π, π]."""
+    unlimited = np.isinf(task.lower) & np.isinf(task.upper)
+    values = demos[:, unlimited]
+    shifted = np.where(values < 0, values + 2 * np.pi, values)
+    wraps = np.ptp(shifted, axis=0) <= np.ptp(values, axis=0) - np.pi
+    return [str(name) for name, w in zip(np.asarray(task.joint_names)[unlimited], wraps) if w]
 
 
 def fit_finding(model: Any) -> Finding:
