@@ -80,7 +80,7 @@ def test_numpy_reads_a_plain_csv_as_the_cell_by_cell_reader(tmp_path_factory, ro
     path = tmp_path_factory.mktemp("csv") / "d.csv"
     path.write_bytes((eol.join(["a, b ,c", *(",".join(cell.format(v) for v in row) for row in rows)]) + end).encode())
     fast = load_demos(path)
-    with patch.object(latentrl.demos, "_numbers_below_header", lambda text: None):
+    with patch.object(latentrl.demos, "_numbers_below_header", lambda text, joint_map: None):
         cells = load_demos(path)
     np.testing.assert_array_equal(fast.postures, cells.postures)
     assert fast.joint_names == cells.joint_names == ("a", "b", "c")
@@ -108,7 +108,9 @@ def write(tmp_path, name, text):
         ("d.csv", "a,b\n1,2\n3,nan\n", "posture 1, joint 'b': non-finite value nan"),
         ("d.csv", "a,b\ninf,2\n", "posture 0, joint 'a': non-finite value inf"),
         ("d.csv", "a,b,a\n1,2,3\n", r"duplicate joint names \['a'\]"),
-        ("d.csv", "a,,c\n1,2,3\n", "every name must be a non-empty string"),
+        ("d.csv", "a,,c\n1,2,3\n", r"column 2 has no name in the header but values \(line 2 \(posture 0\): '2'\): "
+                                   r"name it in the header \(a joint, or a column to leave out with --joint-map NAME= "
+                                   r"\(joint_map=\{'NAME': ''\}\)\)"),
         ("d.json", "{", "not valid JSON"),
         ("d.json", '{"postures": [[1]]}', 'keys "joint_names" and "postures"'),
         ("d.json", '{"joint_names": ["a"], "postures": 1}', "must be lists"),
@@ -224,3 +226,32 @@ def test_max_postures_below_what_a_fit_needs_is_named(tmp_path):
     save_demos(Demonstrations(np.arange(12.0).reshape(4, 3), ("a", "b", "c")), tmp_path / "d.csv")
     with pytest.raises(ValueError, match=r"max_postures \(--max-postures\) = 2 keeps fewer postures than the 3"):
         load_demos(tmp_path / "d.csv", max_postures=2, min_postures=3)
+
+
+@pytest.mark.parametrize("fast", [True, False])
+def test_columns_the_joint_map_leaves_out_are_never_parsed(tmp_path, fast):
+    """A time stamp, a gripper's state in words, a ROS export's empty frame id: mapped to nothing
+    (`--joint-map stamp=`), they said "joint 'stamp': '2024-05-01T12:00:00.000' is not a number"."""
+    path = write(tmp_path, "d.csv", "stamp,a,gripper,frame_id,b\n"
+                                    "2024-05-01T12:00:00.000,0.1,open,,0.2\n2024-05-01T12:00:01.001,0.3,closed,,0.4\n")
+    drop = {"stamp": "", "gripper": "", "frame_id": ""}
+    with patch.object(latentrl.demos, "_numbers_below_header", latentrl.demos._numbers_below_header if fast
+                      else lambda text, joint_map: None):
+        demos = load_demos(path, joint_map=drop)
+        assert demos.joint_names == ("a", "b") and demos.postures.tolist() == [[0.1, 0.2], [0.3, 0.4]]
+        with pytest.raises(ValueError, match=r"line 2 \(posture 0\), joint 'stamp': '2024-05-01T12:00:00.000' is not"):
+            load_demos(path, joint_map={"gripper": "", "frame_id": ""})  # a kept column is still named
+        write(tmp_path, "ragged.csv", "stamp,a,b\nx,0.1,0.2\ny,0.3,0.4,0.5\n")
+        with pytest.raises(ValueError, match=r"line 3 \(posture 1\): 4 values, expected 3"):
+            load_demos(tmp_path / "ragged.csv", joint_map={"stamp": ""})
+
+
+def test_an_empty_unnamed_column_is_absent_and_a_dataframe_index_is_named(tmp_path):
+    """A trailing comma on every line said "joint '': '' is not a number"; a pandas index column
+    "joint_names: every name must be a non-empty string"."""
+    trailing = load_demos(write(tmp_path, "d.csv", "a,b,\n0.1,0.2,\n0.3,0.4,\n"))
+    assert trailing.joint_names == ("a", "b") and trailing.postures.tolist() == [[0.1, 0.2], [0.3, 0.4]]
+    with pytest.raises(ValueError, match=r"d.csv: column 1 has no name in the header but values \(line 2 \(posture "
+                                         r"0\): '0'\): it looks like a DataFrame's index written with the CSV; write "
+                                         r"it with to_csv\(index=False\)"):
+        load_demos(write(tmp_path, "d.csv", ",a,b\n0,0.1,0.2\n1,0.3,0.4\n"))

@@ -110,20 +110,45 @@ def _is_number(text: str) -> bool:
     return True
 
 
-def _table(rows: Sequence[tuple[str, Sequence[Any]]], names: Sequence[str]) -> NDArray[np.float64]:
-    """(label, cells) rows → (N, D) floats; ragged rows and non-numbers named by label and joint."""
-    values = np.empty((len(rows), len(names)))
+def _table(rows: Sequence[tuple[str, Sequence[Any]]], names: Sequence[str],
+           columns: Sequence[int]) -> NDArray[np.float64]:
+    """(label, cells) rows → (N, len(columns)) floats of those `columns` (the others are never
+    parsed); ragged rows and non-numbers named by label and joint."""
+    values = np.empty((len(rows), len(columns)))
     for i, (label, cells) in enumerate(rows):
         if len(cells) != len(names):
             raise ValueError(f"{label}: {len(cells)} values, expected {len(names)} (one per joint)")
-        for j, cell in enumerate(cells):
-            values[i, j] = _number(cell, f"{label}, joint {names[j]!r}")
+        for k, j in enumerate(columns):
+            values[i, k] = _number(cells[j], f"{label}, joint {names[j]!r}")
     return values
 
 
-def _read_csv(path: Path) -> Demonstrations:
+def _mapped(names: Sequence[str], joint_map: Mapping[str, str]) -> tuple[list[int], tuple[str, ...]]:
+    """The columns of `names` kept after `joint_map` (a column mapped to "", or named "", is left
+    out) and their new names."""
+    new = renamed(names, joint_map) if joint_map else tuple(names)  # duplicates: `Demonstrations` names them
+    kept = kept_columns(new, None, "demo columns")
+    return kept, tuple(new[c] for c in kept)
+
+
+def _unnamed(names: Sequence[str], rows: Sequence[tuple[str, Sequence[str]]]) -> None:
+    """A column without a name whose every cell is empty (a trailing comma on every line) is left
+    out; one with a value is a ValueError naming it (a DataFrame's index when it is the first)."""
+    for c in (c for c, name in enumerate(names) if not name):
+        label, cell = next(((label, row[c]) for label, row in rows if c < len(row) and row[c].strip()), ("", ""))
+        if not cell:
+            continue
+        where = f"column {c + 1} has no name in the header but values ({label}: {cell!r})"
+        if c == 0:
+            raise ValueError(f"{where}: it looks like a DataFrame's index written with the CSV; write it "
+                             "with to_csv(index=False)")
+        raise ValueError(f"{where}: name it in the header (a joint, or a column to leave out with --joint-map NAME= "
+                         "(joint_map={'NAME': ''}))")
+
+
+def _read_csv(path: Path, joint_map: Mapping[str, str]) -> Demonstrations:
     text = utf8(path.read_bytes().removeprefix(codecs.BOM_UTF8), " (a spreadsheet's 'CSV UTF-8')")
-    fast = _numbers_below_header(text)
+    fast = _numbers_below_header(text, joint_map)
     if fast is not None:
         return fast
     reader = csv.reader(io.StringIO(text, newline=""))
@@ -134,35 +159,39 @@ def _read_csv(path: Path) -> Demonstrations:
         raise ValueError("empty file (no header row)")
     (_, header), body = lines[0], lines[1:]
     names = [name.strip() for name in header]
-    if all(_is_number(name) for name in names):
+    if all(_is_number(name) for name in names if name):
         raise ValueError(f"line {lines[0][0]} holds numbers, not joint names: the first row must name the joints")
     other = next((sep for sep in (";", "\t", "|") if len(names) == 1 and sep in names[0]), None)
     if other is not None:
         raise ValueError(f"line 1 is one column, {names[0]!r}: the file is separated by {other!r}, not by commas")
     rows = [(f"line {line} (posture {i})", row) for i, (line, row) in enumerate(body)]
-    return Demonstrations(_table(rows, names), tuple(names))
+    _unnamed(names, rows)
+    kept, kept_names = _mapped(names, joint_map)
+    return Demonstrations(_table(rows, names, kept), kept_names)
 
 
-def _numbers_below_header(text: str) -> Demonstrations | None:
-    """A header of names over rows of plain finite numbers, parsed by NumPy's C reader (2 million
-    rows of 7 joints in 3.5 s, not 19); None for anything else, which `_read_csv` reads cell by
-    cell (and names the line, the posture and the joint of what is wrong)."""
+def _numbers_below_header(text: str, joint_map: Mapping[str, str]) -> Demonstrations | None:
+    """A header of names over rows of plain finite numbers (in the columns `joint_map` keeps;
+    the others are never parsed), read by NumPy's C reader (2 million rows of 7 joints in 3.5 s,
+    not 19); None for anything else, which `_read_csv` reads cell by cell (and names the line,
+    the posture and the joint of what is wrong)."""
     header, _, body = text.partition("\n")
     if header.lstrip().startswith("#"):
         return None  # comments above the header: the cell-by-cell reader skips them
-    names = next(csv.reader([header]), [])
-    if not names or not body or body.isspace() or all(_is_number(name) for name in names):  # isspace, not strip: no copy of a large body
-        return None
+    names = [name.strip() for name in next(csv.reader([header]), [])]
+    if not all(names) or not body or body.isspace() or all(_is_number(name) for name in names):  # isspace, not strip: no copy of a large body
+        return None  # an unnamed column: the cell-by-cell reader checks that it is empty
+    kept, kept_names = _mapped(names, joint_map)
     try:
-        values = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2, dtype=np.float64)
+        values = np.loadtxt(io.StringIO(body), delimiter=",", comments=None, ndmin=2, dtype=np.float64, usecols=kept)
     except ValueError:
         return None
-    if values.shape[1] != len(names) or not np.isfinite(values).all():
-        return None  # a non-finite value: the cell-by-cell reader names its line
-    return Demonstrations(values, tuple(name.strip() for name in names))
+    if body.count(",") != len(values) * (len(names) - 1) or not np.isfinite(values).all():
+        return None  # a ragged row (or a quoted comma), a non-finite value: the cell-by-cell reader names its line
+    return Demonstrations(values, kept_names)
 
 
-def _read_json(path: Path) -> Demonstrations:
+def _read_json(path: Path, joint_map: Mapping[str, str]) -> Demonstrations:
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as err:
@@ -176,10 +205,10 @@ def _read_json(path: Path) -> Demonstrations:
         if not isinstance(row, list):
             raise ValueError(f"posture {i}: expected a list of numbers, got {row!r}")
     rows = [(f"posture {i}", row) for i, row in enumerate(postures)]
-    return Demonstrations(_table(rows, names), tuple(names))
+    return _remapped(Demonstrations(_table(rows, names, range(len(names))), tuple(names)), joint_map)
 
 
-def _read_npz(path: Path) -> Demonstrations:
+def _read_npz(path: Path, joint_map: Mapping[str, str]) -> Demonstrations:
     arrays = read_npz(path)
     missing = sorted({"postures", "joint_names"} - arrays.keys())
     if missing:
@@ -192,7 +221,14 @@ def _read_npz(path: Path) -> Demonstrations:
             "joint_names: expected a 1-D array of strings, "
             f"got dtype {names.dtype} shape {names.shape}"
         )
-    return Demonstrations(postures, tuple(str(name) for name in names), arrays.get("episodes"), arrays.get("frames"))
+    demos = Demonstrations(postures, tuple(str(name) for name in names), arrays.get("episodes"), arrays.get("frames"))
+    return _remapped(demos, joint_map)
+
+
+def _remapped(demos: Demonstrations, joint_map: Mapping[str, str]) -> Demonstrations:
+    """`demos` with `joint_map` applied to its columns."""
+    kept, names = _mapped(demos.joint_names, joint_map)
+    return Demonstrations(demos.postures[:, kept], names, demos.episodes, demos.frames)
 
 
 def _write_csv(demos: Demonstrations, fh: IO[bytes]) -> None:
@@ -214,18 +250,18 @@ def _write_npz(demos: Demonstrations, fh: IO[bytes]) -> None:
     np.savez(fh, **arrays)
 
 
-_FORMATS: dict[
-    str, tuple[Callable[[Path], Demonstrations], Callable[[Demonstrations, IO[bytes]], None]]
-] = {
+_Reader = Callable[[Path, Mapping[str, str]], Demonstrations]
+"""Reads a file of postures, applying a joint map (old → new; new "": the column is left out)."""
+_Writer = Callable[[Demonstrations, IO[bytes]], None]
+
+_FORMATS: dict[str, tuple[_Reader, _Writer]] = {
     ".csv": (_read_csv, _write_csv),
     ".json": (_read_json, _write_json),
     ".npz": (_read_npz, _write_npz),
 }
 
 
-def _format(
-    path: Path,
-) -> tuple[Callable[[Path], Demonstrations], Callable[[Demonstrations, IO[bytes]], None]]:
+def _format(path: Path) -> tuple[_Reader, _Writer]:
     try:
         return _FORMATS[path.suffix.lower()]
     except KeyError:
@@ -325,11 +361,7 @@ def _load_file(path: Path, expected_joints: Sequence[str] | None, joint_map: Map
         raise ValueError(f"{path}: {size} bytes, more than the {MAX_DEMO_FILE_BYTES} a demo file may have "
                          "(it is read whole); demonstrations are postures, not trajectories of millions of rows")
     try:
-        demos = read(path)
-        if joint_map:
-            names = renamed(demos.joint_names, joint_map)
-            kept = kept_columns(names, None, "demo columns")
-            demos = Demonstrations(demos.postures[:, kept], tuple(names[c] for c in kept), demos.episodes, demos.frames)
+        demos = read(path, joint_map)
         if expected_joints is not None:
             demos = _select(demos, tuple(expected_joints))
     except (ValueError, csv.Error) as err:
