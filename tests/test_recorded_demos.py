@@ -137,6 +137,29 @@ def test_degrees_are_refused_and_converted_on_request(tmp_path):
     assert load_demos(path, expected_joints=NAMES).postures.shape == (16, 3)
 
 
+def test_a_tasks_demos_convert_only_its_angular_joints_and_drop_a_mimic_column(tmp_path):
+    """`--degrees` converted a prismatic finger's metres too (0.02 m became 0.00035) without a word,
+    and `load_demos(..., expected_joints=task.joint_names)` refused a mimic column the CLI drops."""
+    task = Task.from_dict({"name": "arm7", "urdf": str(ROOT / "tests/robots/arm7_description/urdf/arm7_primitives.urdf"),
+                           "root": "fixed", "effectors": ["tcp"], "target": {"position": [[0.4, 0.0, 0.6]]}})
+    radians = np.array([[0.0, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8, 0.02], [0.5, 0.6, -0.2, -1.5, 0.3, 2.2, 0.0, 0.04],
+                        [-0.4, 0.2, 0.3, -2.2, -0.3, 1.8, -0.8, 0.0]])
+    recorded = np.column_stack([np.degrees(radians[:, :7]), radians[:, 7:], radians[:, 7]])  # the mimic finger last
+    names = (*task.joint_names, "finger_joint2")
+    save_demos(Demonstrations(recorded, names), tmp_path / "d.csv")
+    write_hdf5(tmp_path / "d.h5", [recorded[:2], recorded[2:]], names)
+    for path in (tmp_path / "d.csv", tmp_path / "d.h5"):
+        demos = task.demos(path, degrees=True)
+        assert demos.joint_names == task.joint_names
+        np.testing.assert_allclose(demos.postures, radians, atol=1e-12)
+    assert task.demos(tmp_path / "d.h5", degrees=True).episodes.tolist() == [0, 0, 1]
+    with pytest.raises(ValueError, match=r"d.csv: joint names do not match the expected ones: missing \[\], unknown "
+                                         r"\['finger_joint2'\] \(a task's demonstrations, a mimic joint's column checked "
+                                         r"against its leader and dropped: Task.demos\(path\); a column to leave out: "
+                                         r"joint_map=\{'finger_joint2': ''\}\)"):
+        load_demos(tmp_path / "d.csv", expected_joints=task.joint_names)
+
+
 def test_the_save_of_npz_keeps_the_episodes(tmp_path):
     write_lerobot(tmp_path / "ds", episodes_of())
     demos = load_demos(tmp_path / "ds", max_postures=6)

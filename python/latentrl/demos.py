@@ -28,7 +28,7 @@ from numpy.typing import NDArray
 from latentrl._files import not_regular, utf8
 from latentrl._persistence import PathLike, atomic_write, read_npz
 from latentrl.recorded import KINDS, open_recording, read_frames, recording_kind
-from latentrl.recorded.frames import kept_columns, refuse_radians, renamed
+from latentrl.recorded.frames import Degrees, kept_columns, renamed, to_radians
 from latentrl.recorded.sampling import farthest_points
 
 
@@ -275,9 +275,9 @@ def _select(demos: Demonstrations, expected: Sequence[str]) -> Demonstrations:
     missing = [name for name in expected if name not in demos.joint_names]
     unknown = [name for name in demos.joint_names if name not in expected]
     if missing or unknown:
-        raise ValueError(
-            f"joint names do not match the expected ones: missing {missing}, unknown {unknown}"
-        )
+        hint = (" (a task's demonstrations, a mimic joint's column checked against its leader and dropped: "
+                f"Task.demos(path); a column to leave out: joint_map={{{unknown[0]!r}: ''}})") if unknown else ""
+        raise ValueError(f"joint names do not match the expected ones: missing {missing}, unknown {unknown}{hint}")
     columns = [demos.joint_names.index(name) for name in expected]
     return Demonstrations(demos.postures[:, columns], tuple(expected), demos.episodes, demos.frames)
 
@@ -293,7 +293,7 @@ def load_demos(
     min_postures: int = 1,
     max_postures: int | None = None,
     joint_map: Mapping[str, str] | None = None,
-    degrees: bool = False,
+    degrees: Degrees = False,
     key: str | None = None,
     joint_names: Sequence[str] | None = None,
 ) -> Demonstrations:
@@ -304,9 +304,11 @@ def load_demos(
     `joint_map` renames joints (old → new) before they are matched; a joint mapped to ``""`` is
     left out (a time stamp, a gripper: ``{"time": ""}``). With `expected_joints`, a
     file of postures must name exactly those joints; a recording must have them and its other
-    joints (a gripper, a wheel) are dropped; the columns are returned in that order. `degrees`:
-    the values are degrees, converted to radians (a recording's kept joint beyond ±2π is refused
-    without it, as looking like degrees). `key`: where a recording keeps the joint positions (the
+    joints (a gripper, a wheel) are dropped; the columns are returned in that order (a robot's
+    demonstrations as `latentrl train` reads them, mimic columns checked and dropped: `Task.demos`).
+    `degrees`: the values are degrees, converted to radians: every column (True) or the joints
+    named (a robot's revolute and continuous ones; `Task.demos` passes them); a recording's kept
+    joint beyond ±2π is refused without it, as looking like degrees. `key`: where a recording keeps the joint positions (the
     LeRobot feature, default ``observation.state``; the HDF5 obs key, default
     ``robot0_joint_pos``; the ROS topic, default ``/joint_states``); `joint_names`: the names of
     a recording that has none. A recording's episode and frame index per posture are kept
@@ -349,7 +351,7 @@ def load_demos(
 
 
 def _load_file(path: Path, expected_joints: Sequence[str] | None, joint_map: Mapping[str, str],
-               degrees: bool) -> Demonstrations:
+               degrees: Degrees) -> Demonstrations:
     read, _ = _format(path)
     info = path.stat()  # a missing file: FileNotFoundError, an OSError
     size = info.st_size
@@ -369,8 +371,9 @@ def _load_file(path: Path, expected_joints: Sequence[str] | None, joint_map: Map
     except RecursionError as err:
         raise ValueError(f"{path}: nested too deeply to read") from err
     if degrees:
-        refuse_radians(demos.postures, str(path))
-        demos = Demonstrations(np.radians(demos.postures), demos.joint_names, demos.episodes, demos.frames)
+        postures = demos.postures.copy()
+        to_radians(postures, demos.joint_names, degrees, str(path))
+        demos = Demonstrations(postures, demos.joint_names, demos.episodes, demos.frames)
     return demos
 
 

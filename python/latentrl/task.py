@@ -23,7 +23,9 @@ from numpy.typing import NDArray
 
 from latentrl import _native
 from latentrl._files import MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded, read_text
+from latentrl.demos import Demonstrations, load_demos
 from latentrl.episode_ends import end_counts, end_reasons
+from latentrl.recorded import recording_kind
 from latentrl.task_schema import (
     by_path,
     changed_since,
@@ -182,6 +184,32 @@ class Task:
         chosen = rows[:, columns]
         self._refuse_degrees(chosen, where)
         return chosen
+
+    def demos(self, path: str | Path, **options: Any) -> Demonstrations:
+        """This robot's demonstrations from `path`, a file of postures or a recording read by
+        `load_demos` with `options` (its keywords but `expected_joints`), as `latentrl train` and
+        `check` read them: the actuated joints in URDF order (a file's columns in any order, a mimic
+        joint's checked against its leader and dropped: `demo_postures`; a recording's other joints
+        dropped). With ``degrees=True`` only the revolute and continuous joints are converted to
+        radians, a prismatic joint's metres kept. ValueError naming the file and what does not fit."""
+        recorded = recording_kind(Path(path)) is not None
+        if options.get("degrees") is True:
+            options["degrees"] = self._angular_joints(str(path))
+        loaded = load_demos(path, expected_joints=self.joint_names if recorded else None, **options)
+        postures = self.demo_postures(loaded.joint_names, loaded.postures, str(path))
+        return Demonstrations(postures, self.joint_names, loaded.episodes, loaded.frames)
+
+    def _angular_joints(self, where: str) -> tuple[str, ...]:
+        """The robot's joints (mimic ones too) whose positions are angles, not lengths (prismatic):
+        those `--degrees` converts; ValueError naming `where` for a robot without any."""
+        from latentrl.robot_info import urdf_info
+
+        joints = urdf_info(self.urdf_path, balance_inertia=bool(self.to_dict()["balance_inertia"]))["joints"]
+        angular = tuple(str(j["name"]) for j in joints if j["type"] != "prismatic")
+        if not angular:
+            raise ValueError(f"{where}: --degrees (degrees=True) was given, but {self.origin}'s robot has only "
+                             "prismatic joints, whose positions are lengths; drop --degrees")
+        return angular
 
     def postures_of(self, demos: Any, where: str = "demos") -> NDArray[np.float64]:
         """`demos` as this robot's (N, D) postures: a DataFrame whose columns are named (strings)

@@ -17,8 +17,6 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from latentrl._files import MAX_MESH_BYTES, MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded
-from latentrl.demos import load_demos
-from latentrl.recorded import recording_kind
 from latentrl.recorded.options import DemoOptions
 from latentrl.gplvm import GPLVM, check_fitted_gplvm
 from latentrl.task import SHIPPED, Task, end_reasons
@@ -54,11 +52,7 @@ class TrainRun(TrainPreset, DemoOptions):
 def _inputs(task_file: str, overrides: str, demos: str, options: DemoOptions) -> tuple[Task, np.ndarray]:
     """The task with its overrides and the demo postures in its joints' order."""
     task = Task.load(task_file).replace(json.loads(overrides))
-    # A recording's other joints (a gripper, a wheel) are dropped; a file of postures names the robot's.
-    recorded = recording_kind(Path(demos)) is not None
-    loaded = load_demos(demos, min_postures=3, expected_joints=task.joint_names if recorded else None,
-                        **options.load_kwargs())
-    return task, task.demo_postures(loaded.joint_names, loaded.postures, demos)
+    return task, task.demos(demos, min_postures=3, **options.load_kwargs()).postures
 
 
 @lru_cache(maxsize=2)

@@ -8,7 +8,7 @@ A reader (`Recording`) knows from metadata alone its joint names and each episod
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
@@ -28,15 +28,29 @@ holds at most twice the cap (512 MiB) plus one episode as recorded."""
 
 REVOLUTE_BOUND = 2 * math.pi
 """A kept joint whose recorded values go beyond ±2π looks like degrees: refused without `degrees`;
-with it, values none of which goes beyond look like radians already (`refuse_radians`)."""
+with it, values none of which goes beyond look like radians already (`to_radians`)."""
 
 
-def refuse_radians(values: NDArray[np.float64], where: str) -> None:
-    """A ValueError naming `where` when values said to be degrees all lie within ±2π: they look
-    like radians (converted again, every motion would shrink 57-fold without a word)."""
-    if values.size and not (np.abs(values) > REVOLUTE_BOUND).any():
+Degrees = bool | Collection[str]
+"""Which joints' values are degrees: all (True), none (False), or those named (a robot's angular
+joints: `Task.demos` leaves a prismatic joint's metres as they are)."""
+
+
+def to_radians(values: NDArray[np.float64], names: Sequence[str], degrees: Degrees, where: str) -> None:
+    """Converts in place the columns of `values` (named `names`) that `degrees` gives as degrees;
+    a ValueError naming `where` when their values all lie within ±2π: they look like radians
+    (converted again, every motion would shrink 57-fold without a word)."""
+    if isinstance(degrees, str):
+        raise TypeError(f"degrees: expected a bool or a collection of joint names, got the string {degrees!r}")
+    columns = [c for c, name in enumerate(names) if degrees is True or (degrees and name in degrees)]
+    if not len(values) or not columns:
+        return
+    largest = max(float(np.abs(values[:, c]).max()) for c in columns)  # a column at a time: no copy of them all
+    if not largest > REVOLUTE_BOUND:
         raise ValueError(f"{where}: --degrees (degrees=True) was given, but no value lies beyond ±2π (the largest "
-                         f"is {np.abs(values).max():g}): these look like radians already; drop --degrees")
+                         f"is {largest:g}): these look like radians already; drop --degrees")
+    for c in columns:
+        np.radians(values[:, c], out=values[:, c])
 
 
 @dataclass(frozen=True)
@@ -137,7 +151,7 @@ def _finite(block: NDArray[np.float64], names: tuple[str, ...], episode: Episode
 
 
 def read_frames(recording: Recording, *, expected_joints: Sequence[str] | None = None,
-                joint_map: Mapping[str, str] | None = None, degrees: bool = False,
+                joint_map: Mapping[str, str] | None = None, degrees: Degrees = False,
                 max_postures: int | None = None) -> Frames:
     """The frames of `recording` as postures. The rule, in order:
 
@@ -149,8 +163,9 @@ def read_frames(recording: Recording, *, expected_joints: Sequence[str] | None =
        before anything is read (`frame_step`);
     4. each episode read (every k-th frame past the cap), a frame with a NaN or infinite
        kept value refused naming its episode and frame;
-    5. units: with `degrees`, every kept value is converted to radians; without it, a kept
-       joint whose values reach beyond ±2π is refused as looking like degrees.
+    5. units: with `degrees`, every kept value (or those of the joints it names) is converted to
+       radians; without it, a kept joint whose values reach beyond ±2π is refused as looking like
+       degrees.
 
     Errors are ValueErrors naming the file (and field) and what is wrong where."""
     where = f"{recording.path} ({recording.field})"
@@ -180,8 +195,7 @@ def read_frames(recording: Recording, *, expected_joints: Sequence[str] | None =
         _finite(values[start:start + count], kept, episode, step)
         start += count
     if degrees:
-        refuse_radians(values, where)
-        np.radians(values, out=values)
+        to_radians(values, kept, degrees, where)
     else:
         beyond = np.abs(values) > REVOLUTE_BOUND
         if beyond.any():

@@ -33,7 +33,7 @@ class DemoOptions:
     joint_map: str = ""
     """Renames of the demonstrations' joints before they are matched to the robot's, old=new[,old=new…]; old= (nothing after =) leaves that column out (a time stamp, a gripper)."""
     degrees: bool = False
-    """The demonstrations' joint values are degrees: convert them to radians (without it, a recorded joint beyond ±2π is refused as looking like degrees)."""
+    """The demonstrations' joint values are degrees: convert them to radians (train, check: the robot's revolute and continuous joints, a prismatic joint's metres kept; fit, which knows no robot: every column). Without it, a recorded joint beyond ±2π is refused as looking like degrees."""
     max_postures: int = 0
     """At most this many postures, chosen by farthest-point sampling in joint space from the first frame (0: all; docs/demos.md)."""
 
