@@ -349,3 +349,53 @@ def test_a_given_model_encodes_with_the_runs_encoder(tmp_path):
     assert fitted(TrainRun(**given, encoder="tracking"))[2].encoder == "tracking"
     with pytest.raises(ValueError, match=r"--encoder gp: .*b\.npz was fitted with the 'back_constrained' encoder"):
         fitted(TrainRun(**given, encoder="gp"))
+
+
+def test_a_model_of_other_joints_or_order_is_refused_naming_both(tmp_path, capsys):
+    """A model file kept no joint names: one fitted to the glass arm's columns reordered (wrist,
+    shoulder, elbow) trained without a word and learnt nothing (session 14's sweep, 0 % reached),
+    and `check` advised on the scrambled space. `latentrl fit` now records the demo file's columns,
+    a DataFrame's fit its columns; train, check, the API and a policy refuse other joints or another
+    order by name. A model without names (fitted to an array, or saved before) is taken as before."""
+    import pandas as pd
+
+    from latentrl import GPLVM, Task, train_latent_policy
+    from latentrl.check import check
+    from latentrl.experiments.training import TrainRun, fitted
+
+    demos = load_demos(EXAMPLE / "demos.csv")
+    joints = ["shoulder", "elbow", "wrist"]
+    assert list(demos.joint_names) == joints
+    order = [2, 0, 1]
+    csv = tmp_path / "reordered.csv"
+    np.savetxt(csv, demos.postures[:, order], delimiter=",", header="wrist,shoulder,elbow", comments="")
+    assert cli.main(["fit", str(csv), "--max-iter", "20", "--out", str(tmp_path / "m.npz")]) == 0
+    assert list(GPLVM.load(tmp_path / "m.npz").feature_names_in_) == ["wrist", "shoulder", "elbow"]
+    run = TrainRun(task_file=str(EXAMPLE / "glass_arm.toml"), demos=str(EXAMPLE / "demos.csv"),
+                   model=str(tmp_path / "m.npz"))
+    in_order = (r"m\.npz: fitted to the task's joints in another order, \['wrist', 'shoulder', 'elbow'\]; "
+                r"the task's joints are \['shoulder', 'elbow', 'wrist'\]")
+    with pytest.raises(ValueError, match=in_order):
+        fitted(run)
+    capsys.readouterr()
+    assert cli.main(["check", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"),
+                     "--model", str(tmp_path / "m.npz")]) == 1
+    assert re.search(in_order, capsys.readouterr().err)
+
+    task = Task.load(EXAMPLE / "glass_arm.toml")
+    frame = pd.DataFrame(demos.postures[:, order], columns=["wrist", "shoulder", "elbow"])
+    model = GPLVM(max_iter=20, random_state=0).fit(frame)
+    for call in (lambda: check(task, demos.postures, model), lambda: train_latent_policy(model, task, trials=1)):
+        with pytest.raises(ValueError, match=r"model.*in another order, \['wrist', 'shoulder', 'elbow'\]"):
+            call()
+    with pytest.raises(ValueError, match="model: fitted to the task's joints in another order"):
+        LatentPolicy(task=task, model=model, demos=demos.postures, latent_low=np.zeros(2), latent_high=np.ones(2),
+                     weights=np.zeros((1, 400)))
+    other = GPLVM(max_iter=20, random_state=0).fit(frame.set_axis(["wrist", "shoulder", "knee"], axis=1))
+    with pytest.raises(ValueError, match=r"fitted to 3 joints \['wrist', 'shoulder', 'knee'\], not to the task's "
+                                         r"3 joints \['shoulder', 'elbow', 'wrist'\]"):
+        check(task, demos.postures, other)
+    named = GPLVM(max_iter=20, random_state=0).fit(pd.DataFrame(demos.postures, columns=joints))
+    plain = GPLVM(max_iter=20, random_state=0).fit(demos.postures)
+    for ok in (named, plain):
+        assert check(task, demos.postures, ok).verdict

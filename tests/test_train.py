@@ -252,7 +252,7 @@ def test_a_task_files_run_table_sets_the_run_and_arguments_and_flags_win(arms_mo
         ({"preset": "huge"}, ValueError, "preset must be 'quick' or 'paper'"),
         ({"episodes_per_trial": 3}, ValueError, "unknown preset fields"),
         ({"episodes": 0}, ValueError, r"run.episodes must be an integer in \[1, 100000000\], got 0"),
-        ({"task": "humanoid_lift"}, ValueError, "humanoid_lift needs a GPLVM fitted to postures of its 19 joints"),
+        ({"task": "humanoid_lift"}, ValueError, r"model for humanoid_lift: fitted to 4 joints.*not to the task's 19 joints"),
         ({"overrides": {"learner.alpha": 2.0}}, ValueError, r"learner.alpha must lie in \(0, 1\], got 2"),
     ],
 )

@@ -119,7 +119,7 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
     as `train` fits); `latent_margin`: the box's margin (default: the task's `[run]`, else
     `TrainPreset`'s)."""
     from latentrl.derive import SPACING, applied, derive, even_twin
-    from latentrl.gplvm import GPLVM, check_fitted_gplvm
+    from latentrl.gplvm import GPLVM, check_fitted_gplvm, check_model_joints
     from latentrl.run_settings import TrainPreset, latent_box, with_task_run
     from latentrl.task_schema import check_run
 
@@ -128,6 +128,7 @@ def check(task: Task, demos: Any, model: Any = None, *, latent_margin: float | N
         check_run({"latent_margin": latent_margin})  # its one rule, named as run.latent_margin
     if model is not None:
         check_fitted_gplvm(model)
+        check_model_joints(model, task.joint_names, "model")
     preset = with_task_run(TrainPreset(), task)
     even: Callable[[], Any] | None = None
     if model is None:  # fitted as `latentrl train` fits, its latent spacing derived as there
@@ -301,7 +302,7 @@ def encoder_finding(model: Any, survey: dict[str, Any]) -> Finding:
         return Finding("encoder", "ok", "the tracking encoder keeps the commanded point of a tracked move "
                        "(0 learner steps by construction)", None, {"median_steps": 0.0, "p90_steps": 0.0})
     points = survey["points"][admissible]
-    back = model.transform(model.inverse_transform(points))
+    back = model._encode(model.inverse_transform(points))
     step = float(np.min(survey["spacing"]) / survey["stride"])
     steps = np.linalg.norm(back - points, axis=1) / step
     median = float(np.median(steps))

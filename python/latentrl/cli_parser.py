@@ -275,7 +275,7 @@ def _add_training_flags(cmd: argparse.ArgumentParser, quick: str) -> None:
 
     cmd.add_argument("task", type=_path, help="the task file (TOML; docs/tasks.md)")
     cmd.add_argument("--demos", type=_path, required=True, help=DEMOS_HELP)
-    cmd.add_argument("--model", type=_path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2)")
+    cmd.add_argument("--model", type=_path, help="a saved GPLVM (`latentrl fit`) instead of fitting one (d = 2); fitted to the task's joints in its order")
     cmd.add_argument("--quick", action="store_true", help=quick)
     cmd.add_argument("--no-progress", dest="progress", action="store_false", help="no progress bar")
     _add_preset_flags(cmd, TrainRun, exclude=("task_file", "demos", "model"))

@@ -4,6 +4,7 @@ decodes to the demonstrated postures, with two inverse maps to encode."""
 from __future__ import annotations
 
 from dataclasses import replace
+from collections.abc import Sequence
 from typing import Any, ClassVar, Literal, Self, overload
 
 import numpy as np
@@ -161,7 +162,8 @@ class GPLVM(Estimator):
         Number of joints D.
     feature_names_in_ : ndarray (D,) of str objects
         The joint names: the column names of a pandas DataFrame passed to `fit`, if they
-        are all strings (not set otherwise).
+        are all strings (not set otherwise); `latentrl fit` records the demo file's. A latent
+        run refuses a model whose names are not its task's joints in order (`check_model_joints`).
 
     Notes
     -----
@@ -442,6 +444,12 @@ class GPLVM(Estimator):
         """Encodes postures `X` (M, D), an array or DataFrame, to latent points (M, d),
         with the out-of-sample GP (`method="gp"`) or the iterative projection; default: the
         `encoder` parameter."""
+        return self._encode(self._check_X(X), method)
+
+    def _encode(self, X: Any, method: str | None = None) -> NDArray[np.float64]:
+        """`transform` of postures whose columns are those of the fit, unnamed, without the
+        warning that they have no names: latentrl's own calls with a task's joints, which
+        `check_model_joints` compared with the fit's."""
         self._check_fitted()
         method = self.encoder if method is None else method
         self._check_encoder(method)
@@ -449,7 +457,7 @@ class GPLVM(Estimator):
         if method not in (fitted, "projection", "tracking"):
             raise ValueError(f"method {method!r}: this GPLVM was fitted with the {fitted!r} encoder, "
                              f"so transform takes {fitted!r} or 'projection'")
-        X = self._check_X(X)
+        X = as_matrix("X", X, n_cols=self.n_features_in_)
         if method in ("projection", "tracking"):
             return self.projection_.encode(X)
         return self.encoder_.predict_mean(X)
@@ -483,6 +491,23 @@ def check_fitted_gplvm(model: Any) -> None:
     """TypeError unless `model` is a fitted GPLVM: the model a latent run (`check`, training) maps with."""
     if not isinstance(model, GPLVM) or not hasattr(model, "decoder_"):
         raise TypeError(f"model must be a fitted latentrl.GPLVM, got {model!r}")
+
+
+def check_model_joints(model: GPLVM, joint_names: Sequence[str], where: str) -> None:
+    """ValueError naming `where` unless the fitted `model` decodes the joints `joint_names` (a
+    task's, in its order): as many columns and, if the fit recorded its columns' names
+    (`feature_names_in_`), those names in that order. A model is never reordered: its latent space
+    was fitted to its columns as they were."""
+    joints = [str(name) for name in joint_names]
+    names = [str(name) for name in getattr(model, "feature_names_in_", ())]
+    if model.n_features_in_ == len(joints) and names in ([], joints):
+        return
+    fitted = f"fitted to {model.n_features_in_} joints" + (f" {names}" if names else "")
+    if sorted(names) == sorted(joints):
+        raise ValueError(f"{where}: fitted to the task's joints in another order, {names}; the task's joints are "
+                         f"{joints}: fit it again to postures in that order (a demo file's columns in that order, "
+                         "a DataFrame's df[list(task.joint_names)]), or train without it (train fits one)")
+    raise ValueError(f"{where}: {fitted}, not to the task's {len(joints)} joints {joints}")
 
 
 def sparse_first_stage(n: int) -> NDArray[np.intp]:

@@ -116,7 +116,7 @@ def robot_episode(task: Any, model: Any, low: NDArray[np.float64], high: NDArray
     plant.pose_links(base[0], joints[0])
     scene = Scene.of(task, plant, poses[..., :3].reshape(-1, 3), view)  # the target where it stands at the start
     return Recorded(f"{task.name}: {title}", rows[:, slices["effectors"]].reshape(len(rows), -1, 3),
-                    model.transform(joints), weights, low, high, model, scene.config["learner"], scene=scene,
+                    model._encode(joints), weights, low, high, model, scene.config["learner"], scene=scene,
                     poses=poses)
 
 

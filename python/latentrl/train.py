@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from latentrl import _native
 from latentrl._persistence import FORMAT_VERSION, PathLike, atomic_write, check_format, read_npz
 from latentrl.episode_ends import end_reasons
-from latentrl.gplvm import GPLVM
+from latentrl.gplvm import GPLVM, check_model_joints
 from latentrl.rollout_summary import format_rollout, rollout_summary
 from latentrl.task import Task, task_digest
 
@@ -65,6 +65,7 @@ class LatentPolicy:
         if self.demos.ndim != 2 or self.demos.shape[1] != joints or not np.isfinite(self.demos).all():
             raise ValueError(f"demos: expected finite postures of shape (N, {joints}), got shape {self.demos.shape}"
                              + ("" if np.isfinite(self.demos).all() else " with NaN or infinite values"))
+        check_model_joints(model, task.joint_names, "model")
         self.latent_low, self.latent_high = np.asarray(latent_low), np.asarray(latent_high)
         self.weights = np.asarray(weights, dtype=np.float64)
         """(trials, rbf_per_dim^d) final TD(0) weights of V; with `learner.move_correction`

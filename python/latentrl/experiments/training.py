@@ -18,7 +18,7 @@ import numpy as np
 
 from latentrl._files import MAX_MESH_BYTES, MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded
 from latentrl.recorded.options import DemoOptions
-from latentrl.gplvm import GPLVM, check_fitted_gplvm
+from latentrl.gplvm import GPLVM, check_fitted_gplvm, check_model_joints
 from latentrl.task import SHIPPED, Task, end_reasons
 from latentrl.run_settings import TrainPreset, latent_box, with_overrides, with_task_run
 from latentrl.train import RECORD, LatentPolicy
@@ -66,8 +66,7 @@ def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, mode
     gplvm = GPLVM.load(model) if model else GPLVM(n_components=2, max_iter=max_iter, random_state=seed, encoder=encoder,
                                                   spacing=spacing)
     if model:
-        if gplvm.n_features_in_ != len(task.joint_names):
-            raise ValueError(f"{model}: fitted to {gplvm.n_features_in_} joints, the task's robot has {len(task.joint_names)}")
+        check_model_joints(gplvm, task.joint_names, model)
         fit = gplvm.fitted_encoder_  # "gp" or "back_constrained": projection and tracking run on either
         if encoder in ("gp", "back_constrained") and encoder != fit:
             raise ValueError(f"--encoder {encoder}: {model} was fitted with the {fit!r} encoder, which is another fit; "
@@ -271,11 +270,7 @@ def train_latent_policy(
         raise ValueError(f"preset must be 'quick' or 'paper', got {preset!r}")
     check_fitted_gplvm(model)
     task, chosen = _preset_for(task, preset == "quick", {**fields, **(overrides or {})})
-    if model.n_features_in_ != len(task.joint_names):
-        raise ValueError(
-            f"{task.name} needs a GPLVM fitted to postures of its {len(task.joint_names)} joints "
-            f"{list(task.joint_names)}; got n_features_in_={model.n_features_in_}"
-        )
+    check_model_joints(model, task.joint_names, f"model for {task.name}")
     starts = model.X_train_ if demos is None else task.postures_of(demos)
     low, high = latent_box(model.Z_, chosen.latent_margin)
     if isinstance(chosen, TrainPreset):  # a Task of yours (not a shipped experiment): derive what it leaves open
