@@ -399,3 +399,29 @@ def test_a_model_of_other_joints_or_order_is_refused_naming_both(tmp_path, capsy
     plain = GPLVM(max_iter=20, random_state=0).fit(demos.postures)
     for ok in (named, plain):
         assert check(task, demos.postures, ok).verdict
+
+
+def test_rollout_and_report_of_a_run_stopped_before_its_policy_name_the_command_that_finishes_it(tmp_path, capsys):
+    """A train stopped by Ctrl-C after a trial was saved holds results.json but no policy.npz:
+    `rollout` said "[Errno 2] No such file or directory: 'half/policy.npz'" and `report` "no
+    policy.npz there (a directory of latentrl train)" (session 14's sweep). Both now name the
+    stopped run and the `latentrl train … --resume` command that finishes it, which does."""
+    from latentrl.experiments.training import TrainRun, run_training
+
+    run = TrainRun(task_file=str(EXAMPLE / "glass_arm.toml"), demos=str(EXAMPLE / "demos.csv"), trials=1, episodes=3,
+                   test_episodes=1, task={"episode.max_steps": 10})
+    out = tmp_path / "half"
+    run_training(run, out, progress=False)
+    (out / "policy.npz").unlink()
+    capsys.readouterr()
+    errors = []
+    for command in (["rollout", str(out), "--out", str(tmp_path / "ro"), "--no-progress"], ["report", str(out)]):
+        assert cli.main(command) == 1
+        errors.append(capsys.readouterr().err)
+    assert errors[0] == errors[1], errors
+    said = re.search(r"a run of latentrl train stopped before its policy.npz was written \(1 of 1 trials saved\); "
+                     r"finish it with: latentrl (train .*--resume.*)", errors[0])
+    assert said is not None, errors[0]
+    assert "--episode.max-steps 10" in said.group(1) and "--episodes 3" in said.group(1)
+    assert cli.main([*shlex.split(said.group(1)), "--no-progress"]) == 0
+    assert (out / "policy.npz").is_file()

@@ -129,9 +129,48 @@ def _report_of(out: Path, *, write: bool = False, as_json: bool = False) -> None
 
 def _report(args: argparse.Namespace) -> int:
     if not (args.results / "policy.npz").is_file():
-        raise ValueError(f"{args.results}: no policy.npz there (a directory of latentrl train)")
+        raise ValueError(_no_policy(args.results))
     _report_of(args.results, as_json=args.json)
     return 0
+
+
+def _no_policy(folder: Path) -> str:
+    """Why `report` and `rollout` find no policy.npz in `folder`: an unfinished run of `latentrl
+    train` (Ctrl-C, a full disk) and the command that finishes it, or no such run."""
+    from latentrl.experiments.run_folder import RunFolder
+
+    if RunFolder(folder).holds_run():
+        name, run = saved_run(folder, train=True)
+        if name == "train":
+            done = RunFolder(folder).finished()[1].get("latent", 0)
+            return (f"{folder}: a run of latentrl train stopped before its policy.npz was written ({done} of "
+                    f"{run.trials} trials saved); finish it with: {_resume_command(folder, run)}")
+    return f"{folder}: no policy.npz there (a directory of latentrl train)"
+
+
+def _resume_command(out: Path, run: Any) -> str:
+    """The `latentrl train … --resume` command that continues `run` in `out`: its files, and a flag
+    for each setting other than the task file gives."""
+    import shlex
+
+    from latentrl.experiments.training import TrainRun
+    from latentrl.task import Task
+
+    try:
+        base = with_task_run(TrainRun(), Task.load(run.task_file))
+    except (OSError, ValueError):  # the task file is gone or broken: resume names it
+        base = TrainRun()
+    words = ["latentrl", "train", run.task_file, "--demos", run.demos, *(["--model", run.model] if run.model else []),
+             "--out", str(out), "--resume"]
+    for field in dataclasses.fields(TrainRun):
+        value = getattr(run, field.name)
+        if field.name in ("task", "task_file", "demos", "model") or value == getattr(base, field.name):
+            continue
+        flag = _flag(field.name)
+        words += [flag if value else f"--no-{flag[2:]}"] if isinstance(value, bool) else [flag, str(value)]
+    for key, value in run.task.items():
+        words += [_flag(key), value if isinstance(value, str) else json.dumps(value)]
+    return shlex.join(words)
 
 
 def _check(args: argparse.Namespace) -> int:
@@ -161,6 +200,8 @@ def _rollout(args: argparse.Namespace) -> int:
     from latentrl.train import LatentPolicy
 
     path = args.results / "policy.npz" if args.results.is_dir() else args.results
+    if args.results.is_dir() and not path.is_file():
+        raise ValueError(_no_policy(args.results))
     if args.episodes < 1:
         raise ValueError(f"--episodes must be at least 1, got {args.episodes}")
     policy = LatentPolicy.load(path)
