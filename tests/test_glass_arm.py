@@ -425,3 +425,22 @@ def test_rollout_and_report_of_a_run_stopped_before_its_policy_name_the_command_
     assert "--episode.max-steps 10" in said.group(1) and "--episodes 3" in said.group(1)
     assert cli.main([*shlex.split(said.group(1)), "--no-progress"]) == 0
     assert (out / "policy.npz").is_file()
+
+
+def test_a_rollout_into_its_run_folder_is_refused(tmp_path, capsys):
+    """`rollout RUN --out RUN` wrote rollout.json beside results.json; `replay RUN --episode 0` then
+    drew a rollout episode as the run's training episode 0 and `--test 0` was refused (session 14's
+    sweep). A rollout's --out that holds a run is refused, naming a folder of its own."""
+    from latentrl.experiments.training import TrainRun, run_training
+
+    run = TrainRun(task_file=str(EXAMPLE / "glass_arm.toml"), demos=str(EXAMPLE / "demos.csv"), trials=1, episodes=3,
+                   test_episodes=1, task={"episode.max_steps": 10})
+    run_training(run, tmp_path / "run", progress=False)
+    capsys.readouterr()
+    for results in (tmp_path / "run", tmp_path / "run" / "policy.npz"):
+        assert cli.main(["rollout", str(results), "--out", str(tmp_path / "run"), "--episodes", "1",
+                         "--no-progress"]) == 1
+        err = capsys.readouterr().err
+        assert f"--out {tmp_path / 'run'}: holds a run (results.json)" in err, err
+        assert f"--out {tmp_path / 'run' / 'rollout'}" in err
+    assert not (tmp_path / "run" / "rollout.json").exists()

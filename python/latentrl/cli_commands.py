@@ -202,6 +202,9 @@ def _rollout(args: argparse.Namespace) -> int:
     path = args.results / "policy.npz" if args.results.is_dir() else args.results
     if args.results.is_dir() and not path.is_file():
         raise ValueError(_no_policy(args.results))
+    if (args.out / "results.json").is_file():  # replay would draw the rollout's episodes as the run's
+        raise ValueError(f"--out {args.out}: holds a run (results.json); a rollout is written to a folder of its "
+                         f"own, e.g. --out {args.out / 'rollout'}")
     if args.episodes < 1:
         raise ValueError(f"--episodes must be at least 1, got {args.episodes}")
     policy = LatentPolicy.load(path)

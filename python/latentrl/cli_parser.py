@@ -189,7 +189,7 @@ def _report_flags(report: argparse.ArgumentParser) -> None:
 
 def _rollout_flags(rollout: argparse.ArgumentParser) -> None:
     rollout.add_argument("results", type=_path, help="a directory of `latentrl train` (with policy.npz), or a policy.npz")
-    rollout.add_argument("--out", type=_path, required=True, help="where to write rollout.json and rollout.npz")
+    rollout.add_argument("--out", type=_path, required=True, help="where to write rollout.json and rollout.npz (a folder of its own, e.g. RUN/rollout)")
     rollout.add_argument("--episodes", type=int, default=20, help="episodes per trial and policy (default: 20)")
     rollout.add_argument("--trial", type=int, help="only this trial's policy (default: every trial)")
     rollout.add_argument("--seed", type=int, default=0, help="base seed of the starts and draws (default: 0)")
