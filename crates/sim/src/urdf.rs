@@ -439,7 +439,7 @@ impl UrdfModel {
             let mimics: Vec<&str> = self.mimics.iter().map(|m| m.joint.name.as_str()).collect();
             return Err(bad(format!(
                 "missing {}, not joints of the robot {} (the columns are its actuated joints {}, in any order, \
-                 and optionally its mimic joints {}; a joint map NAME= leaves another column out)",
+                 and optionally its mimic joints {}; --joint-map NAME= (joint_map={{'NAME': ''}}) leaves another column out)",
                 listed(&missing),
                 listed(&unknown),
                 listed(&self.joint_names()),
