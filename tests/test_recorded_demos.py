@@ -158,6 +158,12 @@ def test_a_tasks_demos_convert_only_its_angular_joints_and_drop_a_mimic_column(t
                                          r"against its leader and dropped: Task.demos\(path\); a column to leave out: "
                                          r"joint_map=\{'finger_joint2': ''\}\)"):
         load_demos(tmp_path / "d.csv", expected_joints=task.joint_names)
+    millimetres = radians.copy()
+    millimetres[:, 7] *= 1000  # the finger's 0.02–0.04 m as 20–40 mm
+    save_demos(Demonstrations(millimetres, task.joint_names), tmp_path / "mm.csv")
+    with pytest.raises(ValueError, match=r"finger_joint1 = 20, beyond ±2π .* finger_joint1 is prismatic, its positions "
+                                         r"metres; these look like millimetres or centimetres"):
+        task.demos(tmp_path / "mm.csv")
 
 
 def test_the_save_of_npz_keeps_the_episodes(tmp_path):

@@ -199,13 +199,17 @@ class Task:
         postures = self.demo_postures(loaded.joint_names, loaded.postures, str(path))
         return Demonstrations(postures, self.joint_names, loaded.episodes, loaded.frames)
 
-    def _angular_joints(self, where: str) -> tuple[str, ...]:
-        """The robot's joints (mimic ones too) whose positions are angles, not lengths (prismatic):
-        those `--degrees` converts; ValueError naming `where` for a robot without any."""
+    def _joint_types(self) -> dict[str, str]:
+        """Each joint's URDF type (mimic joints too), by name."""
         from latentrl.robot_info import urdf_info
 
         joints = urdf_info(self.urdf_path, balance_inertia=bool(self.to_dict()["balance_inertia"]))["joints"]
-        angular = tuple(str(j["name"]) for j in joints if j["type"] != "prismatic")
+        return {str(j["name"]): str(j["type"]) for j in joints}
+
+    def _angular_joints(self, where: str) -> tuple[str, ...]:
+        """The robot's joints (mimic ones too) whose positions are angles, not lengths (prismatic):
+        those `--degrees` converts; ValueError naming `where` for a robot without any."""
+        angular = tuple(name for name, kind in self._joint_types().items() if kind != "prismatic")
         if not angular:
             raise ValueError(f"{where}: --degrees (degrees=True) was given, but {self.origin}'s robot has only "
                              "prismatic joints, whose positions are lengths; drop --degrees")
@@ -240,11 +244,14 @@ class Task:
         rows, columns = np.nonzero(beyond)
         joint, value = self.joint_names[columns[0]], postures[rows[0], columns[0]]
         lower, upper = self.lower[columns[0]], self.upper[columns[0]]
-        raise ValueError(
-            f"{where}: posture {rows[0]} (counting from 0) has {joint} = {value:.6g}, beyond ±2π and outside the "
-            f"joint's limits [{lower:.6g}, {upper:.6g}] ({len(np.unique(rows))} of {len(postures)} postures like "
-            "it): these look like degrees; give --degrees (degrees=True) or write the demonstrations in radians "
-            "(np.deg2rad)")
+        said = (f"{where}: posture {rows[0]} (counting from 0) has {joint} = {value:.6g}, beyond ±2π and outside the "
+                f"joint's limits [{lower:.6g}, {upper:.6g}] ({len(np.unique(rows[columns == columns[0]]))} of "
+                f"{len(postures)} postures like it)")
+        if self._joint_types().get(joint) == "prismatic":
+            raise ValueError(f"{said}: {joint} is prismatic, its positions metres; these look like millimetres or "
+                             "centimetres: divide that column by 1000 or 100")
+        raise ValueError(f"{said}: these look like degrees; give --degrees (degrees=True) or write the "
+                         "demonstrations in radians (np.deg2rad)")
 
     @property
     def warnings(self) -> list[str]:
