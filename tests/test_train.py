@@ -335,8 +335,14 @@ def test_the_advice_follows_how_the_greedy_rollouts_failed_not_training() -> Non
     verdict = training_verdict(policy, episodes=8)
     assert verdict.late_ends["obstacle"] == 10 and verdict.late_ends["timeout"] == 0
     assert len(verdict.next) == 1 and "time out near the target (mean reward 0.70 per step)" in verdict.next[0]
+    assert verdict.verdict == "stopped improving below the target" and not verdict.rising
     greedy["ends"] = np.array([[timeout] * 3 + [obstacle] * 5])
     assert "most failing greedy rollouts end as obstacle" in training_verdict(policy, episodes=8).next[0]
+    # Reaching more in its last tenth than in the one before, it was still improving (the sweep's
+    # "stopped improving below the target" beside "still rising").
+    policy.record["reached"] = np.arange(50)[None] >= 45
+    rising = training_verdict(policy, episodes=8)
+    assert rising.rising and rising.verdict == "still improving below the target"
 
 
 def test_a_trial_stopped_in_a_dip_below_another_is_told() -> None:

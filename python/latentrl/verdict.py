@@ -9,7 +9,9 @@ such a rule, that comes within the reach radius at some step. One of three verdi
 - **learnt**: the better of greedy and soft-max succeeds in at least `LEARNT` of the rollouts,
   and more often than the control;
 - **never reached it**: no training episode came within the reach radius;
-- **stopped improving below the target**: anything between.
+- **still improving below the target**: anything between, the reach rate still rising over the
+  last tenth of training (`RISING`) when the budget or the stopping rule ended it;
+- **stopped improving below the target**: anything between, no longer rising.
 
 With the verdict come the endings of the last fifth of the training episodes each trial ran, whether the reach
 rate was still rising there (more episodes may help), and the next things to try, taken from how
@@ -158,7 +160,7 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
     elif not reached.any():
         verdict = "never reached it"
     else:
-        verdict = "stopped improving below the target"
+        verdict = f"{'still' if rising else 'stopped'} improving below the target"
     names = end_reasons()
     late = last(ends, fifth)
     late_ends = end_counts(late)
