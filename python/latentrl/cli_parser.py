@@ -126,8 +126,8 @@ def build_parser() -> argparse.ArgumentParser:
                    fill=_train_flags)
     sub.add_parser("check", help="before training: will the task learn from these demos? (exit 3 if not)",
                    fill=_check_flags)
-    sub.add_parser("report", help="the verdict on a trained policy: learnt, stopped improving below the "
-                                  "target, or never reached it, with what to try next", fill=_report_flags)
+    sub.add_parser("report", help="the verdict on a trained policy: learnt, still or stopped improving below "
+                                  "the target, or never reached it, with what to try next", fill=_report_flags)
     sub.add_parser("rollout", help="run a trained policy frozen (greedy, soft-max, and the random control from "
                                    "the same starts) and write OUT/rollout.json", fill=_rollout_flags)
     sub.add_parser("fit", help="fit a PCA or GPLVM to a demonstration file and save it (NPZ)", fill=_fit_flags)
