@@ -4,6 +4,7 @@ scikit-learn and pandas are test dependencies only: latentrl does not import the
 
 from __future__ import annotations
 
+import copy
 import pickle
 import warnings
 from typing import Any
@@ -217,9 +218,22 @@ def test_column_names_edge_cases(postures: Any) -> None:
 def test_joint_names_survive_save_load_and_pickle(cls: Any, postures: Any, tmp_path: Any) -> None:
     model = cls(**({"max_iter": 20} if cls is GPLVM else {})).fit(postures)
     model.save(tmp_path / "model.npz")
-    for copy in (cls.load(tmp_path / "model.npz"), pickle.loads(pickle.dumps(model))):
-        assert copy.feature_names_in_.dtype == object
-        assert list(copy.feature_names_in_) == JOINTS
-        np.testing.assert_array_equal(copy.transform(postures), model.transform(postures))
+    for twin in (cls.load(tmp_path / "model.npz"), pickle.loads(pickle.dumps(model))):
+        assert twin.feature_names_in_.dtype == object
+        assert list(twin.feature_names_in_) == JOINTS
+        np.testing.assert_array_equal(twin.transform(postures), model.transform(postures))
     with np.load(tmp_path / "model.npz", allow_pickle=False) as npz:
         assert npz["feature_names_in_"].dtype.kind == "U"
+
+
+@pytest.mark.parametrize("cls", [PCA, GPLVM])
+def test_set_params_without_refit_keeps_the_fit_through_copies(cls: Any, tmp_path: Any) -> None:
+    """As in scikit-learn, `set_params(n_components=1)` leaves the 2-D fit standing until the
+    next `fit`: pickle, deepcopy and save/load keep it (they took d from n_components)."""
+    X = arm_postures(30, np.random.default_rng(0))
+    model = cls(**({"max_iter": 10} if cls is GPLVM else {})).fit(X).set_params(n_components=1)
+    model.save(tmp_path / "model.npz")
+    for twin in (cls.load(tmp_path / "model.npz"), pickle.loads(pickle.dumps(model)), copy.deepcopy(model)):
+        assert twin.n_components == 1 and twin.n_components_ == 2
+        np.testing.assert_array_equal(twin.transform(X), model.transform(X))
+

@@ -87,9 +87,9 @@ class Estimator:
     `GridSearchCV` take it as one of theirs.
 
     Subclasses list in `_saved` every fitted attribute that `save` writes, mapped to its
-    dtype kind and shape: an int is an exact size, ``"d"`` is `n_components`, ``"D"`` is
-    `n_features_in_`, any other symbol (``"N"``) must agree across arrays. `_build` derives
-    the rest of the fitted state from those attributes after `fit` and after `load`.
+    dtype kind and shape: an int is an exact size, ``"D"`` is `n_features_in_`, any other
+    symbol (``"d"``, the fitted latent dimension; ``"N"``) must agree across arrays. `_build`
+    derives the rest of the fitted state from those attributes after `fit` and after `load`.
     `feature_names_in_`, set only when `fit` saw column names, is saved and pickled too.
     """
 
@@ -227,8 +227,9 @@ class Estimator:
 
     def _restore(self, state: dict[str, Any]) -> None:
         """Sets the saved attributes after checking them against `_saved`, then `_build`s."""
-        # "d" is n_components, or for n_components="auto" what the saved latent points have.
-        sizes = {"d": self.n_components} if isinstance(self.n_components, int) else {}
+        # "d" is what the saved arrays agree on, not `n_components`: `set_params` may have
+        # changed that since the fit (as in scikit-learn, the fit stands until the next `fit`).
+        sizes: dict[str, int] = {}
         if "n_features_in_" in state:
             sizes["D"] = int(state["n_features_in_"])
         for name, (kind, shape) in self._saved.items():
