@@ -237,3 +237,15 @@ def test_set_params_without_refit_keeps_the_fit_through_copies(cls: Any, tmp_pat
         assert twin.n_components == 1 and twin.n_components_ == 2
         np.testing.assert_array_equal(twin.transform(X), model.transform(X))
 
+
+def test_numpy_scalar_parameters_are_saved_as_plain_numbers(tmp_path: Any) -> None:
+    """GridSearchCV's grids of np.arange give NumPy scalars: `save` wrote none of them."""
+    X = arm_postures(30, np.random.default_rng(0))
+    search = GridSearchCV(PCA(), {"n_components": np.arange(1, 3)}, scoring=lambda e, X, y=None: 0.0, cv=2)
+    search.fit(X).best_estimator_.save(tmp_path / "pca.npz")
+    assert PCA.load(tmp_path / "pca.npz").get_params() == {"n_components": 1}
+    GPLVM(random_state=np.int64(0), max_iter=np.int64(5)).fit(X).save(tmp_path / "gplvm.npz")
+    loaded = GPLVM.load(tmp_path / "gplvm.npz")
+    assert (loaded.random_state, loaded.max_iter) == (0, 5) and type(loaded.max_iter) is int
+    with pytest.raises(ValueError, match="plain numbers or strings .*Generator"):
+        GPLVM(random_state=np.random.default_rng(0), max_iter=5).fit(X).save(tmp_path / "g.npz")

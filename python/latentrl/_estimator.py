@@ -78,6 +78,14 @@ def check_feature_names(estimator: Any, names: NDArray[np.object_] | None) -> No
     raise ValueError(message)
 
 
+def _plain_number(value: Any) -> Any:
+    """A NumPy scalar (`np.int64(3)`, as GridSearchCV's grids give) as the plain number or
+    string it is, for `json.dumps`; anything else is a TypeError."""
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
+
+
 class Estimator:
     """scikit-learn's estimator contract without depending on it: `__init__` only stores
     its parameters; `get_params`/`set_params`, `__repr__`, pickling and NPZ save/load; the
@@ -269,7 +277,8 @@ class Estimator:
 
     def save(self, path: PathLike) -> None:
         """Writes the parameters and fitted state to an NPZ file at `path` (atomically; the name
-        must end in .npz, the format it holds)."""
+        must end in .npz, the format it holds). Parameters are saved as JSON: NumPy scalars as
+        the plain numbers they are."""
         if not str(path).endswith(".npz"):
             raise ValueError(f"{path}: a model is saved as NPZ; give a file name ending in .npz")
         arrays = self._arrays()
@@ -279,7 +288,7 @@ class Estimator:
         """The arrays `save` writes: format, version, parameters (JSON), fitted state."""
         self._check_fitted()
         try:
-            params = json.dumps(self.get_params())
+            params = json.dumps(self.get_params(), default=_plain_number)
         except TypeError as err:
             raise ValueError(
                 f"cannot save {self!r}: its parameters must be plain numbers or strings ({err})"
