@@ -2,6 +2,7 @@
 GIF or MP4, or a Rerun recording, drawn from the stored path; bad requests exit 1 naming the
 problem and write nothing."""
 
+import importlib.util
 import subprocess
 import sys
 
@@ -95,6 +96,28 @@ def test_a_latentrl_train_run_on_a_custom_task_replays(tmp_path):
     assert main(["replay", str(rolled), "--episode", "0", "--out", str(tmp_path / "moved.gif")]) == 0
     assert main(["replay", str(rolled), "--episode", "5", "--out", str(tmp_path / "x.gif")]) == 1
     assert not (tmp_path / "x.gif").exists()
+
+
+def test_a_run_in_a_1d_latent_space_replays_the_robot_alone(tmp_path, capsys):
+    """V is drawn over a 2-D latent space: a run with a 1-D model replays without the V panel,
+    saying so (it was an IndexError in plots.latent_value_grid; a 3-D model's a shape error)."""
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    model, run = tmp_path / "g1.npz", tmp_path / "run"
+    assert main(["fit", str(example / "demos.csv"), "--n-components", "1", "--max-iter", "20", "--out", str(model)]) == 0
+    assert main(["train", str(example / "glass_arm.toml"), "--demos", str(example / "demos.csv"), "--model", str(model),
+                 "--out", str(run), "--quick", "--trials", "1", "--episodes", "2", "--test-episodes", "1",
+                 "--episode.max-steps", "6", "--no-progress"]) == 0
+    capsys.readouterr()
+    out = tmp_path / "g1.gif"
+    assert main(["replay", str(run), "--test", "0", "--out", str(out), "--max-frames", "3"]) == 0
+    assert "the robot alone: V is drawn over a 2-D latent space, this one is 1-D" in capsys.readouterr().out
+    assert iio.imread(out).shape[1:] == (480, 960, 3)
+    if importlib.util.find_spec("rerun") is not None:
+        assert main(["replay", str(run), "--test", "0", "--rerun", str(tmp_path / "g1.rrd")]) == 0
+        entities = _entities(tmp_path / "g1.rrd")
+        assert entities["/world/robot/tree"] > 0 and not any(path.startswith("/latent") for path in entities)
 
 
 def test_replay_view_3d_draws_the_robot_in_perspective_as_it_moves(runs):

@@ -2,7 +2,7 @@
 (base pose and joints per step, through the native kinematics: no physics re-run, so a replay is
 exact and cheap) with its collision shapes, obstacles, floor and target, beside the learnt V
 over the latent space with the GPLVM variance shading and the latent point moving along its
-path. GIF with Pillow, MP4 with the ffmpeg that imageio-ffmpeg ships: the `[video]` extra."""
+path (over a 2-D latent space; any other: the robot alone). GIF with Pillow, MP4 with the ffmpeg that imageio-ffmpeg ships: the `[video]` extra."""
 
 from __future__ import annotations
 
@@ -69,7 +69,7 @@ def check_output(out: Path) -> None:
 @dataclass(frozen=True)
 class Recorded:
     """One recorded episode and what drawing it needs: the effectors' path (T, E, 3), the
-    latent path (T, 2) on the learner's V (its final `weights` over the box [`low`, `high`]), and
+    latent path (T, d) on the learner's V (its final `weights` over the box [`low`, `high`]), and
     either a robot (`scene` and link poses (T, L, 7)) or Exp 1's toy (its plant `toy`)."""
 
     title: str
@@ -83,6 +83,11 @@ class Recorded:
     scene: Any = None
     poses: NDArray[np.float64] | None = None
     toy: dict[str, Any] | None = None
+
+    @property
+    def value_map(self) -> bool:
+        """Whether V and the latent path are drawn: over a 2-D latent space only."""
+        return bool(self.latent.shape[1] == 2)
 
 
 def recorded(experiment: str, preset: Any, run_dir: Path, rows: NDArray[np.float64], weights: NDArray[np.float64],
@@ -127,8 +132,8 @@ def render_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_fra
 
 def iter_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_frames: int = 400) -> Iterator[NDArray[np.uint8]]:
     """RGB frames (height, width, 3), one at a time: the robot (or Exp 1's hands) at each stored
-    step (left) and V over the latent box with the latent path so far (right). What does not
-    move is drawn once; each frame restores it and draws the moving artists on it
+    step (left) and V over the latent box with the latent path so far (right; a latent space
+    that is not 2-D: the robot alone, `Recorded.value_map`). What does not move is drawn once; each frame restores it and draws the moving artists on it
     (matplotlib's blitting)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -138,19 +143,22 @@ def iter_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_frame
 
     fig = Figure(figsize=(size[0] / 100, size[1] / 100), dpi=100)
     canvas = FigureCanvasAgg(fig)
-    left = view_subplot(fig, VIEWS["top"] if episode.poses is None else episode.scene.view, 1, 2, 1)
-    value = fig.add_subplot(1, 2, 2)
-    latent_value_panel(value, episode.weights, episode.low, episode.high, episode.model, learner=episode.learner,
-                       grid=60)
-    trace, = value.plot([], [], "-", color="w", lw=1.5, animated=True)
-    point, = value.plot([], [], "o", color="r", ms=6, animated=True)
+    left = view_subplot(fig, VIEWS["top"] if episode.poses is None else episode.scene.view, 1,
+                        2 if episode.value_map else 1, 1)
+    tracers: list[Any] = []
+    if episode.value_map:
+        value = fig.add_subplot(1, 2, 2)
+        latent_value_panel(value, episode.weights, episode.low, episode.high, episode.model, learner=episode.learner,
+                           grid=60)
+        tracers = [value.plot([], [], "-", color="w", lw=1.5, animated=True)[0],
+                   value.plot([], [], "o", color="r", ms=6, animated=True)[0]]
     label = left.set_title("", fontsize=8)
     label.set_animated(True)
     if episode.poses is not None:
         scene = episode.scene
         draw_backdrop(left, scene, scene_limits(scene, episode.poses[..., :3].reshape(-1, 3)))  # one view for the episode
         robot = RobotArtists.of(left, scene, animated=True)
-        moving = [*robot.artists, trace, point, label]
+        moving = [*robot.artists, *tracers, label]
 
         def move(step: int) -> None:
             robot.update(episode.poses[step])  # type: ignore[index]
@@ -158,7 +166,7 @@ def iter_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_frame
         draw_toy_backdrop(left, episode.toy)  # type: ignore[arg-type]
         hands, = left.plot([], [], "o-", color="C0", lw=3, animated=True)
         paths = [left.plot([], [], "-", color="C0", lw=0.8, animated=True)[0] for _ in range(2)]
-        moving = [hands, *paths, trace, point, label]
+        moving = [hands, *paths, *tracers, label]
 
         def move(step: int) -> None:
             now = episode.effectors[step]
@@ -175,8 +183,9 @@ def iter_frames(episode: Recorded, size: tuple[int, int] = (960, 480), max_frame
         canvas.restore_region(background)  # type: ignore[no-untyped-call]
         move(step)
         label.set_text(f"step {step} of {steps - 1}")
-        trace.set_data(episode.latent[: step + 1, 0], episode.latent[: step + 1, 1])
-        point.set_data([episode.latent[step, 0]], [episode.latent[step, 1]])
+        if tracers:
+            tracers[0].set_data(episode.latent[: step + 1, 0], episode.latent[: step + 1, 1])
+            tracers[1].set_data([episode.latent[step, 0]], [episode.latent[step, 1]])
         for artist in moving:
             fig.draw_artist(artist)
         yield np.asarray(canvas.buffer_rgba())[..., :3].copy()  # type: ignore[no-untyped-call]
@@ -362,4 +371,6 @@ def render(drawn: Recorded, out: Path | None, rerun: Path | None, *, fps: int = 
 
         write_rerun(drawn, rerun)
         done.append(f"a Rerun recording of {len(drawn.latent)} steps in {rerun}")
-    return f"{drawn.title}: {' and '.join(done)}"
+    alone = "" if drawn.value_map else (f" (the robot alone: V is drawn over a 2-D latent space, this one is "
+                                        f"{drawn.latent.shape[1]}-D)")
+    return f"{drawn.title}: {' and '.join(done)}{alone}"

@@ -60,7 +60,8 @@ def hull_mesh(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray
 
 
 def _log_static(rec: Any, episode: Any) -> None:
-    """What does not move: obstacles, floor, target, the value map and the demos on it."""
+    """What does not move: obstacles, floor, target, the value map and the demos on it (a
+    2-D latent space's, `Recorded.value_map`)."""
     import rerun as rr
 
     from latentrl.render import _corners
@@ -83,6 +84,8 @@ def _log_static(rec: Any, episode: Any) -> None:
                                                    colors=[150, 150, 150], fill_mode="solid"), static=True)
         target = np.column_stack([np.asarray(toy["target"]).reshape(2, 2), np.zeros(2)])
     rec.log("world/target", rr.Points3D(target, colors=[0, 160, 0], radii=0.01), static=True)
+    if not episode.value_map:
+        return
     rec.log("latent/value", rr.Image(value_image(episode)), static=True)
     rec.log("latent/demos", rr.Points2D(to_pixels(episode, episode.model.Z_), colors=[255, 255, 255], radii=1.5),
             static=True)
@@ -143,7 +146,7 @@ def write_rerun(episode: Any, out: Path) -> None:
     with atomic_path(out) as temp:
         rec.save(temp)
         _log_static(rec, episode)
-        latent = to_pixels(episode, episode.latent)
+        latent = to_pixels(episode, episode.latent) if episode.value_map else episode.latent
         for step in range(len(episode.latent)):
             rec.set_time("step", sequence=step)
             if episode.poses is not None:
@@ -152,7 +155,8 @@ def write_rerun(episode: Any, out: Path) -> None:
                 rec.log("world/robot/hands", rr.LineStrips3D([episode.effectors[step]], colors=[60, 110, 200]))
             for k in range(episode.effectors.shape[1]):
                 rec.log(f"world/effectors/{k}", rr.LineStrips3D([episode.effectors[: step + 1, k]], colors=[220, 90, 40]))
-            rec.log("latent/path", rr.LineStrips2D([latent[: step + 1]], colors=[255, 255, 255]))
-            rec.log("latent/point", rr.Points2D(latent[step : step + 1], colors=[255, 0, 0], radii=3))
+            if episode.value_map:
+                rec.log("latent/path", rr.LineStrips2D([latent[: step + 1]], colors=[255, 255, 255]))
+                rec.log("latent/point", rr.Points2D(latent[step : step + 1], colors=[255, 0, 0], radii=3))
         rec.flush()
         rec.disconnect()
