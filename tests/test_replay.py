@@ -185,6 +185,23 @@ def test_bad_rerun_requests_are_named(runs, tmp_path, capsys):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_every_output_is_checked_first_by_its_flag_and_its_missing_folders_are_made(runs, tmp_path, capsys):
+    """A --rerun under a file was named --out; a --rerun in a missing folder was a RuntimeError
+    traceback after the work, a --out there an error after rendering every frame."""
+    (tmp_path / "afile").write_text("")
+    bad = tmp_path / "afile" / "v.rrd"
+    assert main(["replay", str(runs / "exp3"), "--test", "0", "--out", str(tmp_path / "v.gif"), "--rerun", str(bad)]) == 1
+    assert f"--rerun {bad}: cannot write under {tmp_path / 'afile'}" in capsys.readouterr().err
+    assert sorted(tmp_path.iterdir()) == [tmp_path / "afile"]
+    out = tmp_path / "new" / "sub" / "v.gif"
+    assert main(["replay", str(runs / "exp3"), "--test", "0", "--out", str(out), "--max-frames", "2"]) == 0
+    assert out.is_file()
+    if importlib.util.find_spec("rerun") is not None:
+        rerun = tmp_path / "other" / "sub" / "v.rrd"
+        assert main(["replay", str(runs / "exp3"), "--test", "0", "--rerun", str(rerun)]) == 0
+        assert rerun.is_file()
+
+
 def test_a_lifting_arm_is_seen_from_the_side_and_its_height_changes_the_picture():
     """Issue #41: a 3-D arm whose target is above it was drawn top-down (x–y), where a lift does
     not show. The default view keeps the two axes its links and target spread over most; the

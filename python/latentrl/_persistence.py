@@ -58,14 +58,16 @@ def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
 
 @contextlib.contextmanager
 def atomic_path(path: PathLike) -> Iterator[Path]:
-    """A temporary file name beside `path` that keeps its suffix (for writers that take a name
-    and choose the format by it: imageio, rerun), renamed over `path` when the block ends and
-    removed if it raises, so such a writer never leaves a half-written `path`; an OSError in the
-    block names `path` (`naming_os_errors`)."""
+    """A temporary file name beside `path` (missing parent directories are made, as by
+    `atomic_write`) that keeps its suffix (for writers that take a name and choose the format by
+    it: imageio, rerun), renamed over `path` when the block ends and removed if it raises, so such
+    a writer never leaves a half-written `path`; an OSError in the block names `path`
+    (`naming_os_errors`)."""
     path = Path(path)
     tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex}.tmp{path.suffix}")
     try:
         with naming_os_errors(path):
+            path.parent.mkdir(parents=True, exist_ok=True)
             yield tmp
             os.replace(tmp, path)
     finally:

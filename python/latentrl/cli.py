@@ -18,19 +18,27 @@ from latentrl.cli_parser import build_parser
 __all__ = ["build_parser", "main"]
 
 
-def _check_writable(out: Path, *, file: bool) -> None:
-    """`--out` can be written: its nearest existing ancestor is a writable directory (and it is
-    not a directory where a file goes, or a file where a directory goes). Checked before any
-    fit or trial, so a typo costs nothing."""
+def _check_writable(flag: str, out: Path, *, file: bool) -> None:
+    """The output `out` of `flag` can be written: its nearest existing ancestor is a writable
+    directory (missing folders are made, for a file as for a folder) and it is not a directory
+    where a file goes, or a file where a directory goes. Checked before any fit, trial or
+    frame, so a typo costs nothing."""
     if out.exists() and out.is_dir() == file:
-        raise ValueError(f"--out {out}: is {'a directory' if file else 'a file'}, expected {'a file' if file else 'a directory'}")
+        raise ValueError(f"{flag} {out}: is {'a directory' if file else 'a file'}, expected {'a file' if file else 'a directory'}")
     if not file and out.is_symlink() and not out.exists():  # no folder can be made there (File exists, after the work)
-        raise ValueError(f"--out {out}: is a symbolic link to nothing (its target is missing, or the links loop)")
+        raise ValueError(f"{flag} {out}: is a symbolic link to nothing (its target is missing, or the links loop)")
     parent = (out.parent if file else out).absolute()
     while not parent.exists():
         parent = parent.parent
     if not parent.is_dir() or not os.access(parent, os.W_OK | os.X_OK):
-        raise ValueError(f"--out {out}: cannot write under {parent}")
+        raise ValueError(f"{flag} {out}: cannot write under {parent}")
+
+
+OUTPUTS = {"out": "--out", "rerun": "--rerun"}
+"""The path arguments a command writes, by their `args` name, with their flags."""
+
+FILE_OUTPUTS = {("fit", "out"), ("replay", "out"), ("replay", "rerun")}
+"""The outputs that are files (the others are folders), by command and `args` name."""
 
 
 INPUTS = {"task": "task file", "demos": "--demos", "model": "--model", "results": "results", "file": "sweep file",
@@ -68,11 +76,9 @@ def _show_warning(message: Warning | str, category: type[Warning], filename: str
 def _run(args: argparse.Namespace) -> int:
     """Runs the command of `args`; an error is one line on stderr and an exit code."""
     try:
-        out = getattr(args, "out", None)
-        if out is not None:
-            _check_writable(out, file=args.command in ("fit", "replay"))
-        if getattr(args, "rerun", None) is not None:
-            _check_writable(args.rerun, file=True)
+        for name, flag in OUTPUTS.items():
+            if getattr(args, name, None) is not None:
+                _check_writable(flag, getattr(args, name), file=(args.command, name) in FILE_OUTPUTS)
         _check_inputs(args)
         return COMMANDS[args.command](args)
     except (ValueError, OSError) as err:

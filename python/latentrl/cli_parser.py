@@ -23,7 +23,8 @@ the figures of a results directory, show versions.
 
 Exit codes: 0 done, 1 bad values, a bad file or a failed run (the message says what), 2 bad
 arguments (argparse), 3 `check` found that the task will not learn, 130 interrupted (finished
-trials are kept; `--resume` continues).
+trials are kept; `--resume` continues). Every output (--out, --rerun) is checked before any
+work; the folders missing on its path are made.
 """
 """The description `latentrl --help` starts with."""
 
