@@ -33,6 +33,18 @@ def test_info_on_a_full_disk_says_so_in_one_line():
     assert result.stderr.strip() == "latentrl: error: cannot write to standard output: No space left on device"
 
 
+def test_a_terminal_that_lacks_a_character_gets_its_escape_not_an_error():
+    """PYTHONIOENCODING=ascii (or latin-1, a Latin-1 locale): `train --help` failed on "…", `check` after its
+    survey on "×", `train` after its fit on "−", each exit 1."""
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    env = {**os.environ, "PYTHONIOENCODING": "ascii"}
+    for args, escape in [(["train", "--help"], "\\u2026"),
+                         (["check", str(example / "glass_arm.toml"), "--demos", str(example / "demos.csv")], "\\xd7")]:
+        result = subprocess.run([sys.executable, "-m", "latentrl", *args], capture_output=True, text=True, env=env,
+                                timeout=300)
+        assert result.returncode == 0 and escape in result.stdout, result.stderr
+
+
 def test_info_prints_versions_git_revision_and_threads_as_json():
     """What the README promises of `latentrl info`: versions, git revision, thread count."""
     result = latentrl("info")

@@ -5,6 +5,7 @@ exit codes (`latentrl.cli_parser.DESCRIPTION` lists them)."""
 from __future__ import annotations
 
 import argparse
+import io
 import os
 import sys
 import warnings
@@ -61,10 +62,20 @@ RECORDING_LIBRARIES = ("pyarrow", "h5py", "rosbags")
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
+    _tolerant_streams()
     args = build_parser().parse_args(argv)
     with warnings.catch_warnings():
         warnings.showwarning = _show_warning
         return _run(args)
+
+
+def _tolerant_streams() -> None:
+    """stdout and stderr write a character their encoding lacks as its escape (``\\u2212``)
+    instead of failing: on an ASCII or Latin-1 terminal (PYTHONIOENCODING, the locale) `train`
+    failed after its fit printing "−", `--help` on "…"."""
+    for stream in (sys.stdout, sys.stderr):
+        if isinstance(stream, io.TextIOWrapper):
+            stream.reconfigure(errors="backslashreplace")
 
 
 def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
