@@ -417,3 +417,19 @@ def test_a_costly_exact_fit_says_its_cost_first_in_one_line(tmp_path, monkeypatc
     with pytest.warns(UserWarning, match="40 postures: each iteration"):
         gplvm.GPLVM(max_iter=2).fit(rng.uniform(-1, 1, (40, 3)))
     gplvm.GPLVM(max_iter=2).fit(rng.uniform(-1, 1, (30, 3)))  # at the bound: no warning (pytest's -W error)
+
+
+def test_a_run_in_a_folder_named_in_latin1_finishes_and_reports(tmp_path):
+    """`--out` in a folder whose name is not UTF-8 (b"lat\\xe9n", read as a surrogate) trained,
+    then exited 1 before report.json: the policy's task label went to native code as text."""
+    from latentrl import LatentPolicy, Task
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    out = tmp_path / os.fsdecode(b"lat\xe9n") / "run"
+    assert main(["train", str(example / "glass_arm.toml"), "--demos", str(example / "demos.csv"), "--out", str(out),
+                 "--quick", "--trials", "1", "--episodes", "2", "--test-episodes", "1", "--episode.max-steps", "6",
+                 "--no-progress"]) == 0
+    assert (out / "report.json").is_file() and main(["report", str(out)]) == 0
+    assert "lat\\udce9n" in LatentPolicy.load(out / "policy.npz").task.origin
+    task = Task.from_dict(Task.load(example / "glass_arm.toml").to_dict(), example, origin=str(out))
+    assert task.replace({"learner.alpha": 0.5}, origin=str(out)).origin == task.origin

@@ -70,6 +70,13 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _label(origin: str) -> str:
+    """`origin` as valid UTF-8, the text native code takes: a path's undecodable bytes (a folder
+    named in Latin-1, read as surrogates) as their escapes, ``lat\\udce9n``, as Python prints
+    them (a run in such a folder failed after its training, loading its policy)."""
+    return origin.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
 def _set(config: dict[str, Any], key: str, value: Any, origin: str) -> None:
     """Sets the dotted `key` of a nested task dict (tables are created as needed)."""
     *tables, last = key.split(".")
@@ -119,11 +126,12 @@ class Task:
     @classmethod
     def from_dict(cls, config: Mapping[str, Any], base_dir: str | Path = ".", origin: str = "<dict>") -> Task:
         """A task from a dict of task-file keys (nested tables as dicts); the URDF path is
-        relative to `base_dir`."""
+        relative to `base_dir`; `origin` names it in errors (any text: a path that is not
+        UTF-8 is shown with escapes)."""
         if not isinstance(config, Mapping):  # issue #38: a list said "dictionary update sequence element #0 …"
             raise TypeError(f"{origin}: expected a table of task keys (a dict), got {type(config).__name__}")
         base = Path(base_dir)
-        return cls(_native.Task.from_dict(dict(config), base, origin), base, frozenset(key_paths(config)))
+        return cls(_native.Task.from_dict(dict(config), base, _label(origin)), base, frozenset(key_paths(config)))
 
     def replace(self, overrides: Mapping[str, Any], origin: str | None = None) -> Task:
         """This task with `overrides` (dotted keys: ``{"learner.alpha": 0.5}``) applied and checked."""
@@ -133,7 +141,7 @@ class Task:
         name = origin or f"{self.origin} with {', '.join(sorted(overrides))}"
         for key, value in overrides.items():
             _set(config, key, value, name)
-        native = _native.Task.from_dict(config, self.base_dir, name)
+        native = _native.Task.from_dict(config, self.base_dir, _label(name))
         return Task(native, self.base_dir, self.given | frozenset(overrides))
 
     def run_given(self) -> dict[str, Any]:
