@@ -219,13 +219,28 @@ def test_humanoid_task_runs() -> None:
     assert policy.weights.shape == (1, 400 * (1 + 8))  # V, then the task's move corrections
     few = GPLVM(n_components=2, max_iter=20, random_state=0).fit(model.X_train_[:5])
     with pytest.raises(ValueError, match="episode.start_demo = 6 is not a row of the 5 demonstrations"):
-        train_latent_policy(few, "humanoid_lift", overrides={"episode.start_demo": 6})
+        train_latent_policy(few, "humanoid_lift", encoder="gp", overrides={"episode.start_demo": 6})
 
 
 def test_a_task_of_ones_own_trains(arms_model: GPLVM) -> None:
     task = Task.from_dict({**Task.shipped("two_arms").to_dict(), "name": "mine"}, Task.shipped("two_arms").base_dir)
     policy = train_latent_policy(arms_model, task, trials=1, episodes=3, overrides={"episode.max_steps": 20}, test_episodes=1)
     assert policy.task.name == "mine" and policy.returns.shape == (1, 3) and policy.test_returns.shape == (1, 1)
+
+
+def test_the_runs_encoder_maps_the_loop_as_latentrl_train_runs_it(arms_model: GPLVM) -> None:
+    """The run's encoder (a keyword, else the preset's: "tracking" for a Task) maps the loop's
+    states, as `latentrl train --model` runs it; the model given keeps its own, and the preset
+    records what ran (the encoder, the model's fit settings). It was recorded and not used."""
+    table = {key: value for key, value in Task.shipped("two_arms").to_dict().items() if key != "run"}
+    task = Task.from_dict({**table, "name": "mine"}, Task.shipped("two_arms").base_dir)
+    runs = {encoder: train_latent_policy(arms_model, task, trials=1, episodes=3, test_episodes=0, seed=2,
+                                         overrides={"episode.max_steps": 30}, **({"encoder": encoder} if encoder else {}))
+            for encoder in ("", "tracking", "gp")}
+    assert runs[""].model.encoder == runs[""].preset.encoder == "tracking" and arms_model.encoder == "gp"
+    np.testing.assert_array_equal(runs[""].returns, runs["tracking"].returns)
+    assert not np.array_equal(runs["gp"].returns, runs["tracking"].returns)
+    assert (runs["gp"].preset.encoder, runs["gp"].preset.gplvm_max_iter, runs["gp"].preset.latent_spacing) == ("gp", 50, "fit")
 
 
 def test_a_task_files_run_table_sets_the_run_and_arguments_and_flags_win(arms_model: GPLVM, tmp_path: Path) -> None:
@@ -254,6 +269,10 @@ def test_a_task_files_run_table_sets_the_run_and_arguments_and_flags_win(arms_mo
         ({"episodes": 0}, ValueError, r"run.episodes must be an integer in \[1, 100000000\], got 0"),
         ({"task": "humanoid_lift"}, ValueError, r"model for humanoid_lift: fitted to 4 joints.*not to the task's 19 joints"),
         ({"overrides": {"learner.alpha": 2.0}}, ValueError, r"learner.alpha must lie in \(0, 1\], got 2"),
+        ({"encoder": "back_constrained"}, ValueError, r"encoder='back_constrained': the model was fitted with the 'gp' "
+                                                      r"encoder, which is another fit.*give encoder='gp', 'projection'"),
+        ({"gplvm_max_iter": 5}, ValueError, r"^gplvm_max_iter: settings of the GPLVM fit"),
+        ({"overrides": {"run.latent_spacing": "even"}}, ValueError, r"^run.latent_spacing: settings of the GPLVM fit"),
     ],
 )
 def test_bad_arguments(arms_model: GPLVM, kwargs: dict[str, object], error: type, message: str) -> None:

@@ -6,6 +6,7 @@ The same training from Python, in memory: `train_latent_policy` (`latentrl.train
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import json
 from dataclasses import dataclass
@@ -67,17 +68,27 @@ def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, mode
                                                   spacing=spacing)
     if model:
         check_model_joints(gplvm, task.joint_names, model)
-        fit = gplvm.fitted_encoder_  # "gp" or "back_constrained": projection and tracking run on either
-        if encoder in ("gp", "back_constrained") and encoder != fit:
-            raise ValueError(f"--encoder {encoder}: {model} was fitted with the {fit!r} encoder, which is another fit; "
-                             f"refit it (latentrl fit --encoder {encoder}) or give --encoder {fit}, projection or tracking")
-        gplvm.set_params(encoder=encoder)  # the run's encoder (flag, [run] table, default) maps the RL loop's states
+        use_encoder(gplvm, encoder, model)
     else:
         try:
             gplvm.fit(postures)
         except ValueError as err:  # e.g. identical postures: say which file holds them
             raise ValueError(f"{demos}: {err}") from err
     return task, postures, gplvm
+
+
+def use_encoder(model: GPLVM, encoder: str, where: str, *, api: bool = False) -> None:
+    """Sets the run's `encoder` (flag, `[run]` table, preset default) on the fitted `model`, the
+    map of the RL loop's states (`latentrl train --model`, `train_latent_policy`): "projection"
+    and "tracking" run on either fit, "gp" and "back_constrained" only on their own (each is
+    another fit); a ValueError naming the setting (`--encoder`, or with `api` `encoder=`) and
+    `where` (the model) otherwise."""
+    fit = model.fitted_encoder_
+    if encoder in ("gp", "back_constrained") and encoder != fit:
+        q, given, refit = (repr, "encoder=", "GPLVM(encoder={!r})") if api else (str, "--encoder ", "latentrl fit --encoder {}")
+        raise ValueError(f"{given}{q(encoder)}: {where} was fitted with the {fit!r} encoder, which is another fit; refit it "
+                         f"({refit.format(encoder)}) or give {given}{q(fit)}, {q('projection')} or {q('tracking')}")
+    model.set_params(encoder=encoder)
 
 
 def fitted(run: TrainRun, out: Path | None = None) -> tuple[Task, np.ndarray, GPLVM]:
@@ -268,9 +279,17 @@ def train_latent_policy(
 
     if preset not in ("quick", "paper"):
         raise ValueError(f"preset must be 'quick' or 'paper', got {preset!r}")
+    fit = sorted(k for k in {**fields, **(overrides or {})} if k.removeprefix("run.") in ("gplvm_max_iter", "latent_spacing"))
+    if fit:
+        raise ValueError(f"{', '.join(fit)}: settings of the GPLVM fit, and train_latent_policy trains on the model "
+                         "you fitted; fit it so (GPLVM(max_iter=..., spacing='even'), model.evenly_spaced()), or let "
+                         "latentrl train fit one")
     check_fitted_gplvm(model)
     task, chosen = _preset_for(task, preset == "quick", {**fields, **(overrides or {})})
     check_model_joints(model, task.joint_names, f"model for {task.name}")
+    model = copy.copy(model)  # the run's encoder maps the loop's states; yours keeps its own
+    use_encoder(model, chosen.encoder, "the model", api=True)
+    chosen = dataclasses.replace(chosen, gplvm_max_iter=model.max_iter, latent_spacing=model.spacing)  # the fit that ran
     starts = model.X_train_ if demos is None else task.postures_of(demos)
     low, high = latent_box(model.Z_, chosen.latent_margin)
     if isinstance(chosen, TrainPreset):  # a Task of yours (not a shipped experiment): derive what it leaves open
