@@ -2,8 +2,11 @@
 episode endings as docs/method.md §Reward and endings specifies, determinism given a seed,
 rendering."""
 
+import warnings
+
 import gymnasium as gym
 import numpy as np
+import pandas as pd
 import pytest
 from gymnasium.utils.env_checker import check_env
 
@@ -271,6 +274,21 @@ def test_the_wrapper_penalty_is_the_tasks():
     env.reset(seed=0)
     _, reward, terminated, _, info = env.step(env.action_space.high)
     assert terminated and reward == -3.0 and info["end_reason"] == "box_exit"
+
+
+def test_the_wrapper_takes_a_named_model_in_the_tasks_joint_order():
+    """A model fitted to a DataFrame encodes the robot's postures without a warning per step; one
+    whose columns are the joints in another order is refused (it was taken, reading the joints
+    wrongly)."""
+    names = list(Task.shipped("two_arms").joint_names)
+    frame = pd.DataFrame(arm_postures(40, np.random.default_rng(0)), columns=names)
+    env = LatentSpaceWrapper(TwoArmsEnv(), GPLVM(max_iter=50, random_state=0).fit(frame))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env.reset(seed=0)
+        env.step(np.zeros(2))
+    with pytest.raises(ValueError, match=r"model: fitted to the task's joints in another order, \['right_elbow'"):
+        LatentSpaceWrapper(TwoArmsEnv(), GPLVM(max_iter=50, random_state=0).fit(frame[names[::-1]]))
 
 
 def test_bad_arguments():

@@ -105,7 +105,14 @@ class PCA(Estimator):
 
     def transform(self, X: Any) -> NDArray[np.float64]:
         """Latent points (N, d) of postures `X` (N, D), an array or DataFrame."""
-        X = self._check_X(X)
+        return self._encode(self._check_X(X))
+
+    def _encode(self, X: Any) -> NDArray[np.float64]:
+        """`transform` of postures whose columns are those of the fit, unnamed, without the
+        warning that they have no names: latentrl's own calls with a task's joints, which
+        `check_model_joints` compared with the fit's."""
+        self._check_fitted()
+        X = as_matrix("X", X, n_cols=self.n_features_in_)
         latent: NDArray[np.float64] = (X - self.mean_) @ self.components_.T
         return latent
 

@@ -11,6 +11,7 @@ from gymnasium import spaces
 
 from latentrl import _native, run_settings
 from latentrl.envs.contract import Obs
+from latentrl.gplvm import check_model_joints
 from latentrl.task import end_reasons, run_default
 
 
@@ -25,6 +26,10 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
     terminated. Otherwise it is decoded (`model.inverse_transform`) and handed to the wrapped
     environment as the delta `x̂ − o` from its `action_origin` `o`, which it clips to its own action
     space.
+
+    The model's columns are the wrapped robot's joints: a model fitted to a DataFrame (its
+    `feature_names_in_`) must name a task's joints in `joint_names` order (else a ValueError
+    naming both lists: a latent space is never reordered).
 
     `latent_box` = (low, high), each (d,); default: the bounding box of the GPLVM's latent
     points `Z_` widened by the `[run]` table's default `latent_margin` per side (10 %;
@@ -52,6 +57,9 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
                 f"model must be fitted to postures of {posture.shape[0]} values, "
                 f"got n_features_in_={getattr(model, 'n_features_in_', None)!r}"
             )
+        joints = getattr(env.unwrapped, "joint_names", None)
+        if joints is not None:  # a task's robot: a model that named its columns has its joints in its order
+            check_model_joints(model, joints, "model")
         if variance_threshold is not None:
             if not hasattr(model, "predict_variance"):
                 raise ValueError("variance_threshold needs a model with predict_variance (GPLVM)")
@@ -84,7 +92,8 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
 
     def _encode(self) -> Obs:
         posture = np.asarray(self.env.unwrapped.posture)  # type: ignore[attr-defined]
-        z = np.asarray(self.model.transform(posture[None])[0], dtype=np.float64)
+        encode = getattr(self.model, "_encode", self.model.transform)  # ours: columns checked above, no name warning
+        z = np.asarray(encode(posture[None])[0], dtype=np.float64)
         return np.clip(z, self.latent_low, self.latent_high)
 
     def reset(
