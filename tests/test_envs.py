@@ -276,6 +276,16 @@ def test_the_wrapper_penalty_is_the_tasks():
     assert terminated and reward == -3.0 and info["end_reason"] == "box_exit"
 
 
+def test_the_wrapper_names_an_action_that_is_not_d_finite_numbers(arms_gplvm):
+    """It was an internal "Z: non-finite" message, a NumPy broadcast error, or one value applied
+    to both axes."""
+    env = LatentSpaceWrapper(TwoArmsEnv(), arms_gplvm)
+    env.reset(seed=0)
+    for action in (np.array([np.nan, 0.0]), np.zeros(3), np.zeros(1)):
+        with pytest.raises(ValueError, match="action: expected 2 finite numbers"):
+            env.step(action)
+
+
 def test_the_wrapper_takes_a_named_model_in_the_tasks_joint_order():
     """A model fitted to a DataFrame encodes the robot's postures without a warning per step; one
     whose columns are the joints in another order is refused (it was taken, reading the joints

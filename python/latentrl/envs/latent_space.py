@@ -10,7 +10,7 @@ import numpy as np
 from gymnasium import spaces
 
 from latentrl import _native, run_settings
-from latentrl.envs.contract import Obs
+from latentrl.envs.contract import Obs, checked_action
 from latentrl.gplvm import check_model_joints
 from latentrl.task import end_reasons, run_default
 
@@ -29,7 +29,8 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
 
     The model's columns are the wrapped robot's joints: a model fitted to a DataFrame (its
     `feature_names_in_`) must name a task's joints in `joint_names` order (else a ValueError
-    naming both lists: a latent space is never reordered).
+    naming both lists: a latent space is never reordered). An action that is not d finite
+    numbers is a ValueError naming it.
 
     `latent_box` = (low, high), each (d,); default: the bounding box of the GPLVM's latent
     points `Z_` widened by the `[run]` table's default `latent_margin` per side (10 %;
@@ -108,7 +109,7 @@ class LatentSpaceWrapper(gym.Wrapper[Obs, Obs, Obs, Obs], gym.utils.RecordConstr
         """Moves the latent point by `action` (clipped to ±`max_step`), decodes it and steps
         the wrapped env towards that posture; a refused target ends the episode with the
         penalty instead (``end_reason`` ``"box_exit"`` / ``"variance_gate"``)."""
-        u = np.clip(np.asarray(action, dtype=np.float64), -self.max_step, self.max_step)
+        u = np.clip(checked_action(action, len(self.max_step)), -self.max_step, self.max_step)
         target_z = self.z + u
         variance = None
         if self.variance_threshold is not None:  # a GPLVM: mean and variance in one native call
