@@ -301,6 +301,15 @@ def test_the_wrapper_takes_a_named_model_in_the_tasks_joint_order():
         LatentSpaceWrapper(TwoArmsEnv(), GPLVM(max_iter=50, random_state=0).fit(frame[names[::-1]]))
 
 
+def test_a_task_env_matches_demo_columns_to_the_joints_by_name():
+    names = list(Task.shipped("two_arms").joint_names)
+    frame = pd.DataFrame(shipped_demos("two_arms"), columns=names)
+    starts = [TaskEnv("two_arms", demos=demos).reset(seed=0)[0] for demos in (frame, frame[names[::-1]])]
+    np.testing.assert_array_equal(*starts)
+    with pytest.raises(ValueError, match="knee"):
+        TaskEnv("two_arms", demos=frame.rename(columns={names[0]: "knee"}))
+
+
 def test_bad_arguments():
     with pytest.raises(ValueError, match="drop_tolerance"):
         BimanualReachEnv(drop_tolerance=0.0)

@@ -57,8 +57,9 @@ class TaskEnv(gym.Env[Obs, Obs]):
     "success" when the task's `target.hold_steps` held (not a terminal state: bootstrap it).
 
     ## Arguments
-    `task` (a Task or a shipped task's name), `demos` (N, D; default: the shipped demos of a
-    shipped task, none otherwise), `max_step` (0.1 rad), `reach` (1 m, the observation bound of
+    `task` (a Task or a shipped task's name), `demos` (N, D in `task.joint_names` order, or a
+    DataFrame whose columns name the joints, matched by name: `Task.postures_of`; default: the
+    shipped demos of a shipped task, none otherwise), `max_step` (0.1 rad), `reach` (1 m, the observation bound of
     effector coordinates), `render_mode` (`None` or `"rgb_array"`), `view` (the frames' view:
     "top", "side", "front" or "3d", `latentrl.render.VIEWS`; default: chosen as `render` says).
     """
@@ -84,7 +85,7 @@ class TaskEnv(gym.Env[Obs, Obs]):
         self.task = task
         self.max_step = positive("max_step", max_step)
         self.render_mode = check_render_mode(render_mode, self.metadata["render_modes"])
-        self.demos = None if demos is None else np.ascontiguousarray(demos, dtype=np.float64)
+        self.demos = None if demos is None else task.postures_of(demos)
         self.plant = task.plant(self.demos)
         self.dt = task.rl_dt
         """One env step (s): physics step × sub-steps."""
