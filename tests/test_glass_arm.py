@@ -351,6 +351,22 @@ def test_a_given_model_encodes_with_the_runs_encoder(tmp_path):
         fitted(TrainRun(**given, encoder="gp"))
 
 
+def test_a_given_model_refuses_the_flags_of_a_fit_it_skips(tmp_path):
+    """`train --model M --gplvm-max-iter 5` recorded 5 and ran M as fitted, as the API did before
+    it refused them (session 14's second sweep)."""
+    from latentrl import GPLVM
+
+    GPLVM(n_components=2, random_state=0, max_iter=50).fit(load_demos(EXAMPLE / "demos.csv").postures).save(
+        tmp_path / "m.npz")
+    base = ["train", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"), "--model",
+            str(tmp_path / "m.npz"), "--quick", "--out", str(tmp_path / "out")]
+    for flag, value in (("--gplvm-max-iter", "5"), ("--latent-spacing", "even")):
+        result = latentrl([*base, flag, value])
+        assert result.returncode == 1 and f"{flag}: a setting of the GPLVM fit, which --model" in result.stderr, \
+            result.stderr
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_model_of_other_joints_or_order_is_refused_naming_both(tmp_path, capsys):
     """A model file kept no joint names: one fitted to the glass arm's columns reordered (wrist,
     shoulder, elbow) trained without a word and learnt nothing (session 14's sweep, 0 % reached),

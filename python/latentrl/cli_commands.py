@@ -107,7 +107,12 @@ def _training_run(args: argparse.Namespace, files: dict[str, str]) -> Any:
     from latentrl.task import Task
 
     base = with_task_run(TrainRun.quick() if args.quick else TrainRun(), Task.load(args.task))
-    return dataclasses.replace(with_overrides(base, _overrides(args, TrainRun)), **files)
+    given = _overrides(args, TrainRun)
+    fit = sorted(k for k in given if k in ("gplvm_max_iter", "latent_spacing") and given[k] != "auto")
+    if files.get("model") and fit:  # as train_latent_policy refuses them: a given model is not fitted
+        raise ValueError(f"{_flag(fit[0])}: a setting of the GPLVM fit, which --model {args.model} skips; fit the "
+                         "model so (latentrl fit --max-iter N, --spacing even) or drop the flag")
+    return dataclasses.replace(with_overrides(base, given), **files)
 
 
 def _report_of(out: Path, *, write: bool = False, as_json: bool = False) -> None:
