@@ -175,7 +175,7 @@ def demo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
                        "write the demonstrations in radians (np.deg2rad)", {"joints": looks_like_degrees})
     try:
         codes, _, _ = task.plant(demos).classify(np.ascontiguousarray(demos))
-    except ValueError as err:  # the home posture (Task.plant names it) outside the joint limits
+    except ValueError as err:  # a home posture episodes start at, outside the joint limits (named by its row)
         return Finding("demos", "will not learn", str(err), "fix the demonstrations (or episode.start_demo)")
     names = end_reasons()
     broken = {names[c]: np.flatnonzero(codes == c).tolist() for c in np.unique(codes) if c != 0}

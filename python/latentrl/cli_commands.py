@@ -103,12 +103,12 @@ def _train(args: argparse.Namespace) -> int:
 def _training_run(args: argparse.Namespace, files: dict[str, str]) -> Any:
     """The `TrainRun` of `train` and `check`: the preset (`--quick` or not), the task file's
     `[run]` where the preset holds its default, the flags, and `files`."""
-    from latentrl.experiments.training import TrainRun
+    from latentrl.experiments.training import FIT_SETTINGS, TrainRun
     from latentrl.task import Task
 
     base = with_task_run(TrainRun.quick() if args.quick else TrainRun(), Task.load(args.task))
     given = _overrides(args, TrainRun)
-    fit = sorted(k for k in given if k in ("gplvm_max_iter", "latent_spacing") and given[k] != "auto")
+    fit = sorted(k for k in given if k in FIT_SETTINGS and given[k] != "auto")
     if files.get("model") and fit:  # as train_latent_policy refuses them: a given model is not fitted
         raise ValueError(f"{_flag(fit[0])}: a setting of the GPLVM fit, which --model {args.model} skips; fit the "
                          "model so (latentrl fit --max-iter N, --spacing even) or drop the flag")
@@ -144,10 +144,11 @@ def _no_policy(folder: Path) -> str:
     train` (Ctrl-C, a full disk) and the command that finishes it, or no such run."""
     from latentrl.experiments.run_folder import RunFolder
 
-    if RunFolder(folder).holds_run():
+    run_folder = RunFolder(folder)
+    if run_folder.holds_run():
         name, run = saved_run(folder, train=True)
         if name == "train":
-            done = RunFolder(folder).finished()[1].get("latent", 0)
+            done = run_folder.finished()[1].get("latent", 0)
             return (f"{folder}: a run of latentrl train stopped before its policy.npz was written ({done} of "
                     f"{run.trials} trials saved); finish it with: {_resume_command(folder, run)}")
     return f"{folder}: no policy.npz there (a directory of latentrl train)"

@@ -164,7 +164,8 @@ class Task:
 
     def plant(self, demos: NDArray[np.float64] | None = None) -> _native.TaskPlant:
         """The native plant of this task (home posture: demo `episode.start_demo` of `demos`); a
-        home posture the robot cannot take is named by its row."""
+        home posture the robot cannot take is named by its row where episodes start there, else
+        the robot stands at every joint's 0 within its limits (`sim::TaskPlant::new`)."""
         rows = None if demos is None else np.ascontiguousarray(demos, dtype=np.float64)
         return _native.TaskPlant(self._native, rows)
 

@@ -4,7 +4,7 @@
 The measure is the saved policy's rollouts from the task's test starts (`LatentPolicy.rollout`):
 greedy, by the learner's soft-max, and the random control that cannot learn, from the same
 starts. A task "succeeds" in an episode that ends as its success (`target.hold_steps`) or, without
-such a rule, that comes within the reach radius at some step. One of three verdicts:
+such a rule, that comes within the reach radius at some step. One of four verdicts:
 
 - **learnt**: the better of greedy and soft-max succeeds in at least `LEARNT` of the rollouts,
   and more often than the control;

@@ -77,6 +77,10 @@ def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, mode
     return task, postures, gplvm
 
 
+FIT_SETTINGS = ("gplvm_max_iter", "latent_spacing")
+"""Run settings of the GPLVM fit: a given model (`--model`, `train_latent_policy`'s) skips them."""
+
+
 def use_encoder(model: GPLVM, encoder: str, where: str, *, api: bool = False) -> None:
     """Sets the run's `encoder` (flag, `[run]` table, preset default) on the fitted `model`, the
     map of the RL loop's states (`latentrl train --model`, `train_latent_policy`): "projection"
@@ -279,7 +283,7 @@ def train_latent_policy(
 
     if preset not in ("quick", "paper"):
         raise ValueError(f"preset must be 'quick' or 'paper', got {preset!r}")
-    fit = sorted(k for k in {**fields, **(overrides or {})} if k.removeprefix("run.") in ("gplvm_max_iter", "latent_spacing"))
+    fit = sorted(k for k in {**fields, **(overrides or {})} if k.removeprefix("run.") in FIT_SETTINGS)
     if fit:
         raise ValueError(f"{', '.join(fit)}: settings of the GPLVM fit, and train_latent_policy trains on the model "
                          "you fitted; fit it so (GPLVM(max_iter=..., spacing='even'), model.evenly_spaced()), or let "
