@@ -417,6 +417,24 @@ def test_a_model_of_other_joints_or_order_is_refused_naming_both(tmp_path, capsy
         assert check(task, demos.postures, ok).verdict
 
 
+def test_the_model_a_run_fits_names_its_task_joints(tmp_path, capsys):
+    """The GPLVM `train` fits recorded no joint names, so its model.npz was taken for any task
+    with as many joints; it now names the task's, and another task's run refuses it by name."""
+    from latentrl import GPLVM
+    from latentrl.experiments.training import TrainRun, fitted
+
+    run = TrainRun(task_file=str(EXAMPLE / "glass_arm.toml"), demos=str(EXAMPLE / "demos.csv"), gplvm_max_iter=20)
+    _, _, model = fitted(run)
+    assert list(model.feature_names_in_) == ["shoulder", "elbow", "wrist"]
+    model.save(tmp_path / "m.npz")
+    renamed = GPLVM.load(tmp_path / "m.npz")
+    renamed.feature_names_in_ = np.array(["a", "b", "c"], dtype=object)
+    renamed.save(tmp_path / "other.npz")
+    assert cli.main(["check", str(EXAMPLE / "glass_arm.toml"), "--demos", str(EXAMPLE / "demos.csv"),
+                     "--model", str(tmp_path / "other.npz")]) == 1
+    assert re.search(r"other\.npz: fitted to 3 joints \['a', 'b', 'c'\], not to the task's 3 joints", capsys.readouterr().err)
+
+
 def test_rollout_and_report_of_a_run_stopped_before_its_policy_name_the_command_that_finishes_it(tmp_path, capsys):
     """A train stopped by Ctrl-C after a trial was saved holds results.json but no policy.npz:
     `rollout` said "[Errno 2] No such file or directory: 'half/policy.npz'" and `report` "no

@@ -164,6 +164,9 @@ def test_rollouts_start_where_the_tests_start_and_share_their_starts(arms_model:
         policy.rollout(1, policy="best")
     with pytest.raises(ValueError, match="starts must be 'test' or 'train'"):
         policy.rollout(1, starts="demo")
+    for seed in (-1, 2**64, 1.5, True):  # named as the caller wrote it, not as the binding's base_seed
+        with pytest.raises(ValueError, match=r"seed must be an int in 0\.\.2\*\*64 - 1, got "):
+            policy.rollout(1, seed=seed)
 
 
 def test_a_rollout_takes_one_row_of_weights_or_one_per_trial(arms_model: GPLVM) -> None:

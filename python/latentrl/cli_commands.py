@@ -246,9 +246,9 @@ def _write_rollout(args: argparse.Namespace, path: Path, policy: Any, results: d
 
 
 def _fit(args: argparse.Namespace) -> int:
-    import numpy as np
 
     from latentrl import GPLVM, PCA, load_demos
+    from latentrl.gplvm import name_joints
     from latentrl.recorded.options import DemoOptions
 
     if args.out.suffix != ".npz":
@@ -267,7 +267,7 @@ def _fit(args: argparse.Namespace) -> int:
         model = GPLVM(n_components=args.n_components, max_iter=args.max_iter, random_state=args.seed,
                       inducing=args.inducing, spacing=args.spacing)
     model.fit(demos.postures)
-    model.feature_names_in_ = np.asarray(demos.joint_names, dtype=object)  # train, check refuse other joints
+    name_joints(model, demos.joint_names)
     model.save(args.out)
     episodes = {} if demos.episodes is None else {"episodes": len(set(demos.episodes.tolist()))}
     summary = {"model": type(model).__name__, "file": str(args.out), "postures": len(demos.postures), **episodes,

@@ -493,6 +493,16 @@ def check_fitted_gplvm(model: Any) -> None:
         raise TypeError(f"model must be a fitted latentrl.GPLVM, got {model!r}")
 
 
+def name_joints(model: Estimator, joint_names: Sequence[str]) -> None:
+    """Records on the fitted `model` (GPLVM or PCA) the joints its columns held, as a fit on a
+    DataFrame with those columns would (`feature_names_in_`), so that a run, `check` or a policy
+    later refuses it for other joints (`check_model_joints`)."""
+    names = np.asarray([str(name) for name in joint_names], dtype=object)
+    if len(names) != model.n_features_in_:
+        raise ValueError(f"{len(names)} joint names for a model of {model.n_features_in_} columns")
+    model._set_feature_names(names)
+
+
 def check_model_joints(model: GPLVM, joint_names: Sequence[str], where: str) -> None:
     """ValueError naming `where` unless the fitted `model` decodes the joints `joint_names` (a
     task's, in its order): as many columns and, if the fit recorded its columns' names

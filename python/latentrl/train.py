@@ -139,6 +139,8 @@ class LatentPolicy:
             raise ValueError(f"policy must be one of {list(POLICIES)}, got {policy!r}")
         if starts not in ("test", "train"):
             raise ValueError(f"starts must be 'test' or 'train', got {starts!r}")
+        if not (isinstance(seed, (int, np.integer)) and not isinstance(seed, bool) and 0 <= seed < 2**64):
+            raise ValueError(f"seed must be an int in 0..2**64 - 1, got {seed!r}")
         trials = range(len(self.weights)) if trial is None else range(self._check_trial(trial), trial + 1)
         run = _native.run_task_trials(  # the trials side by side, each from its own weights
             self.task._native, decoder=self.model.decoder_, encoder=self.model.loop_encoder_,

@@ -19,7 +19,7 @@ import numpy as np
 
 from latentrl._files import MAX_MESH_BYTES, MAX_TASK_FILE_BYTES, MAX_URDF_BYTES, read_bounded
 from latentrl.recorded.options import DemoOptions
-from latentrl.gplvm import GPLVM, check_fitted_gplvm, check_model_joints
+from latentrl.gplvm import GPLVM, check_fitted_gplvm, check_model_joints, name_joints
 from latentrl.task import SHIPPED, Task, end_reasons
 from latentrl.run_settings import TrainPreset, latent_box, with_overrides, with_task_run
 from latentrl.train import RECORD, LatentPolicy
@@ -74,6 +74,7 @@ def _load(task_file: str, overrides: str, demos: str, options: DemoOptions, mode
             gplvm.fit(postures)
         except ValueError as err:  # e.g. identical postures: say which file holds them
             raise ValueError(f"{demos}: {err}") from err
+        name_joints(gplvm, task.joint_names)  # the run's model.npz is refused for other joints
     return task, postures, gplvm
 
 

@@ -1,5 +1,5 @@
 //! The on-disk cache of mesh hulls: one small file per (mesh bytes, scale), named by their
-//! SHA-256, in `$LATENTRL_CACHE_DIR`, else `$XDG_CACHE_HOME/latentrl/hulls`, else
+//! SHA-256, in `$LATENTRL_CACHE_DIR`, else `$XDG_CACHE_HOME/latentrl/hulls` (when absolute), else
 //! `~/.cache/latentrl/hulls`.
 //!
 //! A cache is only ever a shortcut, and never trusted (issue #38): the key is public (anyone
@@ -31,9 +31,19 @@ pub const MAX_CACHE_ENTRY_BYTES: u64 = 16 << 20;
 
 /// The default cache folder, or `None` when no home or cache directory is known.
 pub fn default_folder() -> Option<PathBuf> {
-    let env = |name: &str| std::env::var_os(name).filter(|v| !v.is_empty()).map(PathBuf::from);
+    folder_from(|name| std::env::var_os(name))
+}
+
+/// The cache folder the variables read by `var` name. An empty variable counts as unset, as
+/// does a relative `$XDG_CACHE_HOME` (the XDG base directory spec calls it invalid).
+fn folder_from(var: impl Fn(&str) -> Option<std::ffi::OsString>) -> Option<PathBuf> {
+    let env = |name: &str| var(name).filter(|v| !v.is_empty()).map(PathBuf::from);
     env("LATENTRL_CACHE_DIR")
-        .or_else(|| env("XDG_CACHE_HOME").map(|d| d.join("latentrl")))
+        .or_else(|| {
+            env("XDG_CACHE_HOME")
+                .filter(|d| d.is_absolute())
+                .map(|d| d.join("latentrl"))
+        })
         .or_else(|| env("HOME").map(|d| d.join(".cache").join("latentrl")))
         .map(|d| d.join("hulls"))
 }
@@ -207,4 +217,36 @@ fn private_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     #[cfg(unix)]
     std::os::unix::fs::OpenOptionsExt::mode(&mut options, 0o600);
     options.open(path)?.write_all(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn folder(vars: &[(&str, &str)]) -> Option<PathBuf> {
+        folder_from(|name| vars.iter().find(|(n, _)| *n == name).map(|(_, v)| v.into()))
+    }
+
+    #[test]
+    fn the_folder_follows_the_first_usable_variable() {
+        let home = ("HOME", "/home/u");
+        assert_eq!(folder(&[home]), Some("/home/u/.cache/latentrl/hulls".into()));
+        assert_eq!(
+            folder(&[home, ("XDG_CACHE_HOME", "/c")]),
+            Some("/c/latentrl/hulls".into())
+        );
+        assert_eq!(
+            folder(&[home, ("XDG_CACHE_HOME", "rel/c")]),
+            Some("/home/u/.cache/latentrl/hulls".into())
+        );
+        assert_eq!(
+            folder(&[home, ("XDG_CACHE_HOME", "")]),
+            Some("/home/u/.cache/latentrl/hulls".into())
+        );
+        assert_eq!(
+            folder(&[home, ("LATENTRL_CACHE_DIR", "mine")]),
+            Some("mine/hulls".into())
+        );
+        assert_eq!(folder(&[]), None);
+    }
 }
