@@ -108,7 +108,23 @@ def test_demos_that_break_the_constraint_will_not_learn(glass):
     report = check(task, tipped)
     found = next(f for f in report.findings if f.name == "demos")
     assert report.verdict == found.verdict == "will not learn"
-    assert found.message.startswith("80 of 80 rows break a constraint: rows 0, 1, 2")
+    assert found.message.startswith("80 of 80 rows break constraints[0] (orientation on glass): rows 0, 1, 2")
+
+
+def test_the_demos_finding_names_the_constraint_each_row_breaks(glass):
+    """With two constraints, each row is listed under the one(s) it breaks, named as the task
+    file's `[[constraints]]` tables are (by the plant's own rule, one constraint at a time)."""
+    task, demos, _ = glass
+    tight = task.to_dict()["constraints"][0]
+    two = task.replace({"constraints": [tight, {**tight, "max_angle": 0.7}]})
+    tipped = demos.copy()
+    tipped[:, -1] += 0.5
+    tipped[40:, -1] += 0.4  # past 0.7 rad: rows 40..79 break both
+    found = check(two, tipped).findings[0]
+    assert found.message == ("80 of 80 rows break constraints[0] (orientation on glass): rows 0, 1, 2, 3, 4, 5, 6, 7, "
+                             "8, 9 … (80 rows); break constraints[1] (orientation on glass): rows 40, 41, 42, 43, 44, "
+                             "45, 46, 47, 48, 49 … (40 rows)")
+    assert found.values["rows"] == {"drop": list(range(80))}
 
 
 def test_degrees_will_not_learn(glass):

@@ -50,9 +50,8 @@ BROKEN_SHARE = 0.2
 the learner moves on the demos' manifold; other rules (an obstacle touched, a fall, the joint
 limits) and fewer such rows are warnings: the learner can keep off those postures."""
 
-RULE_NAMES = {"box_exit": "outside the joint limits", "drop": "break a constraint", "obstacle": "touch an obstacle",
-              "fall": "fall"}
-"""How the demos finding names the rule a row breaks at rest."""
+RULE_NAMES = {"box_exit": "outside the joint limits", "obstacle": "touch an obstacle", "fall": "fall"}
+"""How the demos finding names the rule a row breaks at rest (a constraint: `broken_constraints`)."""
 
 ADMISSIBLE_SHARE = 0.25
 """Admissible latent points: a warning below this share of the box ("will not learn" at none)."""
@@ -188,7 +187,10 @@ def demo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
         return Finding("demos", "warning", wrap, "unwrap those joints' values", {"joints": wrapped})
     if not rows:
         return Finding("demos", "ok", f"all {len(demos)} rows are admissible postures at rest")
-    what = "; ".join(f"{RULE_NAMES.get(n, 'break the ' + n + ' rule')}: rows {_rows(r)}" for n, r in broken.items())
+    what = "; ".join(f"{RULE_NAMES.get(n, 'break the ' + n + ' rule')}: rows {_rows(r)}" for n, r in broken.items()
+                     if n != "drop")
+    what = "; ".join(filter(None, [what] + [f"break {c}: rows {_rows(r)}" for c, r in
+                                            broken_constraints(task, demos, broken.get("drop", [])).items()]))
     dropped = len(broken.get("drop", [])) / len(demos)
     verdict = "will not learn" if dropped >= BROKEN_SHARE else "warning"
     return Finding("demos", verdict, f"{len(rows)} of {len(demos)} rows {what}" + (f"; {wrap}" if wrap else ""),
@@ -196,6 +198,24 @@ def demo_finding(task: Task, demos: NDArray[np.float64]) -> Finding:
                    + (" (the learner moves on the demos' manifold: most of it breaks the constraint)"
                       if verdict == "will not learn" else ""),
                    {"rows": dict(broken)})
+
+
+def broken_constraints(task: Task, demos: NDArray[np.float64], rows: list[int]) -> dict[str, list[int]]:
+    """The demo `rows` (which break a constraint at rest) by the constraint they break, each named
+    as the task file writes it (``constraints[0] (plane on tip)``): the task's own rule, asked of
+    the plant once per constraint with that constraint alone. A row may break several."""
+    if not rows:
+        return {}
+    picked, drop = np.ascontiguousarray(demos[rows]), end_reasons().index("drop")
+    named = {}
+    for i, rule in enumerate(task.to_dict()["constraints"]):
+        alone = task.replace({"constraints": [rule]})
+        codes, _, _ = alone.plant(demos).classify(picked)
+        broken = [row for row, code in zip(rows, codes) if code == drop]
+        if broken:
+            link = rule.get("link") or " and ".join(rule.get("links") or [])
+            named[f"constraints[{i}] ({rule['kind']} on {link})"] = broken
+    return named
 
 
 def wrapped_joints(task: Task, demos: NDArray[np.float64]) -> list[str]:
