@@ -22,7 +22,7 @@ $(VENV)/.deps: pyproject.toml
 # run still using it; unlinked, that run keeps its copy.
 $(VENV)/.built: $(VENV)/.deps Cargo.toml Cargo.lock $(shell find crates python -name '*.rs' -o -name '*.toml' -o -name '*.py' 2>/dev/null)
 	rm -f python/latentrl/_native.*.so
-	VIRTUAL_ENV=$(CURDIR)/$(VENV) $(VENV)/bin/maturin develop --release --quiet
+	VIRTUAL_ENV="$(CURDIR)/$(VENV)" $(VENV)/bin/maturin develop --release --quiet
 	touch $@
 
 build: $(VENV)/.built ## create the venv, install deps, build the native module
@@ -81,8 +81,9 @@ lint: build ## rustfmt, clippy (warnings are errors), ruff, the native stubs aga
 	$(PY) -m mypy --strict python/latentrl
 
 WHEELS := target/wheels
-# What a user without Rust has: the venv's own bin and the system's, no ~/.cargo/bin.
-NO_RUST_PATH = $(CURDIR)/$(INSTALL_VENV)/bin:/usr/bin:/bin
+# What a user without Rust has: the venv's own bin and the system's, no ~/.cargo/bin (quoted: a
+# checkout's path may hold spaces, as every $(CURDIR) in a recipe here).
+NO_RUST_PATH = "$(CURDIR)/$(INSTALL_VENV)/bin":/usr/bin:/bin
 
 wheel: build ## the abi3 wheel (one for every CPython >= 3.11, manylinux) and the sdist, into target/wheels/
 	rm -rf $(WHEELS)
@@ -100,7 +101,7 @@ install-check: wheel ## the wheel into a fresh venv on a PATH without cargo or r
 	cd $(INSTALL_VENV) && bin/python -c "import sys, latentrl._native as n; sys.exit(not n.__file__.endswith('.abi3.so'))"
 	cd $(INSTALL_VENV) && PATH=$(NO_RUST_PATH) bin/python -m latentrl info > /dev/null
 	cd $(INSTALL_VENV) && bin/python -c "import importlib.util, sys; sys.exit(importlib.util.find_spec('matplotlib') is not None)"
-	cd $(INSTALL_VENV) && PATH=$(NO_RUST_PATH) bin/python $(CURDIR)/tests/core_without_matplotlib.py
+	cd $(INSTALL_VENV) && PATH=$(NO_RUST_PATH) bin/python "$(CURDIR)/tests/core_without_matplotlib.py"
 	PATH=$(NO_RUST_PATH) $(INSTALL_VENV)/bin/python -m pip install --quiet "latentrl[plot]"
 	cd $(INSTALL_VENV) && PATH=$(NO_RUST_PATH) bin/latentrl run exp2 --quick --no-progress --trials 1 --episodes 2 --episode.max-steps 10 \
 		--test-episodes 1 --fig5-samples 50 --gplvm-max-iter 20 --out run
@@ -115,7 +116,7 @@ FUZZ_DICT = $(if $(filter mesh_parse,$(FUZZ_TARGET)),,-dict=fuzz/urdf.dict)
 fuzz: ## cargo fuzz the URDF parser + physics, or the mesh reader, for FUZZ_SECONDS (180) s; FUZZ_TARGET=urdf_parse|urdf_numbers|mesh_parse; installs cargo-fuzz if missing
 	@command -v cargo-fuzz > /dev/null || cargo install --locked cargo-fuzz
 	mkdir -p fuzz/corpus/$(FUZZ_TARGET)
-	RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR=$(CURDIR)/fuzz/target nice -n 10 cargo fuzz run --sanitizer none $(FUZZ_TARGET) \
+	RUSTC_BOOTSTRAP=1 CARGO_TARGET_DIR="$(CURDIR)/fuzz/target" nice -n 10 cargo fuzz run --sanitizer none $(FUZZ_TARGET) \
 		fuzz/corpus/$(FUZZ_TARGET) $(FUZZ_SEEDS) -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 $(FUZZ_DICT) \
 		-print_final_stats=1
 

@@ -73,6 +73,39 @@ def test_a_ros_bag_of_joint_states_loads_each_message_by_its_names(tmp_path, ros
         load_demos(path, joint_names=NAMES)
 
 
+@pytest.mark.parametrize("ros", [1, 2])
+def test_two_publishers_on_one_topic_are_merged_into_frames_of_the_latest_positions(tmp_path, ros):
+    """An arm driver (NAMES) and a gripper driver (one joint, every third message) on
+    /joint_states: each frame holds every joint's latest position, from the first message at
+    which both have spoken; a message naming part of one publisher's joints is refused."""
+    frames = episodes_of((30,), width=4)[0]
+    arm, grip = list(NAMES), ["gripper"]
+
+    def publisher(i, names, positions):
+        return (grip, positions[3:]) if i % 3 == 2 else (names[:3], positions[:3])
+
+    path = write_bag(bag_path(tmp_path, ros), frames, [*NAMES, "gripper"], ros=ros, message=publisher)
+    latest, expected = np.full(4, np.nan), []
+    for i, row in enumerate(frames):
+        part = slice(3, 4) if i % 3 == 2 else slice(0, 3)
+        latest[part] = row[part]
+        if i >= 2:
+            expected.append(latest.copy())
+    demos = load_demos(path, expected_joints=[*arm, *grip])
+    np.testing.assert_array_equal(demos.postures, np.array(expected))
+    assert demos.frames.tolist() == list(range(28))
+
+    def dropping(i, names, positions):
+        names, positions = publisher(i, names, positions)
+        return (names[:2], positions[:2]) if i == 19 else (names, positions)
+
+    path = write_bag(tmp_path / ("drop.bag" if ros == 1 else "drop_bag"), frames, [*NAMES, "gripper"], ros=ros,
+                     message=dropping)
+    with pytest.raises(ValueError, match=r"message 19 names \['shoulder', 'elbow'\], none of the joint sets the "
+                                         r"topic's publishers name \(\[\['shoulder', 'elbow', 'wrist'\], \['gripper'\]\]\)"):
+        load_demos(path)
+
+
 def test_joints_are_matched_by_name_extras_dropped_missing_refused(tmp_path):
     episodes = episodes_of(width=4)
     names = ["l_shoulder", "elbow", "gripper", "wrist"]

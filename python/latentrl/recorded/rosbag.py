@@ -1,7 +1,14 @@
 """A ROS 1 bag (``.bag``) or a ROS 2 bag (its folder, with ``metadata.yaml``) as a `Recording`: the
 ``sensor_msgs/JointState`` messages of one topic (default ``/joint_states``) are the frames of one
 episode, each message's ``position`` matched to its own ``name`` list. Read with the rosbags
-library, without a ROS install (``pip install 'latentrl[rosbag]'``)."""
+library, without a ROS install (``pip install 'latentrl[rosbag]'``).
+
+Several publishers on one topic (an arm driver and a gripper driver on ``/joint_states``) are
+told apart by the joints their messages name: when the messages of the topic's first
+`PUBLISHERS_SEEN_NS` name two or more disjoint sets of joints, each message updates its own
+joints and every message from the first at which all sets have been named is a frame holding
+the latest position of every joint (the frames before it are left out). Name sets that overlap
+are one publisher dropping joints: a message without one of them is refused, naming it."""
 
 from __future__ import annotations
 
@@ -18,6 +25,8 @@ from latentrl.recorded.frames import Episode
 from latentrl.recorded.libraries import needs
 
 DEFAULT_TOPIC = "/joint_states"
+PUBLISHERS_SEEN_NS = 2_000_000_000
+"""How much of a topic's start (bag time, ns) is read for its publishers' joint name sets."""
 JOINT_STATE = ("sensor_msgs/msg/JointState", "sensor_msgs/JointState")
 
 
@@ -42,9 +51,8 @@ class JointStateBag:
         try:
             self._connections = self._topic()
             count = sum(c.msgcount for c in self._connections)
-            self.episodes: tuple[Episode, ...] = (Episode(0, count, f"{path}: topic {self.field}"),)
-            first = next(self._messages(1), None)
-            self.names = tuple(first.name) if first is not None else ()
+            self.names, self._sets, self._first = self._publishers()
+            self.episodes: tuple[Episode, ...] = (Episode(0, count - self._first, f"{path}: topic {self.field}"),)
         except BaseException:
             self._reader.close()
             raise
@@ -60,27 +68,46 @@ class JointStateBag:
             raise ValueError(f"{self.path}: topic {self.field} carries {kinds}, not sensor_msgs/JointState")
         return connections
 
-    def _messages(self, step: int) -> Iterator[Any]:
-        """Every `step`-th message of the topic, deserialized."""
+    def _messages(self, step: int) -> Iterator[tuple[int, Any]]:
+        """Every `step`-th message of the topic, with its bag time (ns), deserialized."""
         try:
-            for i, (connection, _, raw) in enumerate(self._reader.messages(connections=self._connections)):
+            for i, (connection, stamp, raw) in enumerate(self._reader.messages(connections=self._connections)):
                 if i % step == 0:
-                    yield self._reader.deserialize(raw, connection.msgtype)
+                    yield stamp, self._reader.deserialize(raw, connection.msgtype)
         except Exception as err:  # noqa: BLE001 (see _damaged)
             raise _damaged(self.path, err) from err
+
+    def _publishers(self) -> tuple[tuple[str, ...], tuple[frozenset[str], ...], int]:
+        """The topic's joint names, its publishers' name sets (none: one publisher, nothing to
+        merge) and the index of its first complete frame, from its first `PUBLISHERS_SEEN_NS`."""
+        seen: dict[tuple[str, ...], int] = {}  # each name set as its first message lists it, and that message
+        start = 0
+        for i, (stamp, message) in enumerate(self._messages(1)):
+            start = stamp if i == 0 else start
+            if stamp - start > PUBLISHERS_SEEN_NS:
+                break
+            if all(set(message.name) != set(names) for names in seen):
+                seen[tuple(message.name)] = i
+        # A set inside another is a message missing joints, not a publisher: refused when read.
+        kept = [names for names in seen if not any(set(names) < set(other) for other in seen)]
+        sets = [frozenset(names) for names in kept]
+        if len(sets) < 2 or any(a & b for k, a in enumerate(sets) for b in sets[k + 1:]):
+            return (kept[0] if kept else ()), (), 0
+        return tuple(name for names in kept for name in names), tuple(sets), max(seen[names] for names in kept)
 
     def read(self, episode: Episode, step: int) -> NDArray[np.float64]:
         """Every `step`-th message's positions in the order of `names` (a message may list its
         joints in another order); a message without one of them, or with positions that do not
-        match its names, is a ValueError naming the message."""
+        match its names, is a ValueError naming the message. With several publishers, every
+        `step`-th merged frame (the module's docs)."""
+        if self._sets:
+            return self._merged(episode, step)
         rows = np.empty((math.ceil(episode.frames / step), len(self.names)))
         order: dict[tuple[str, ...], list[int]] = {}
         count = 0
-        for message in self._messages(step):
-            names, position = tuple(message.name), message.position
+        for _, message in self._messages(step):
             where = f"{episode.where}: message {count * step}"
-            if len(position) != len(names):
-                raise ValueError(f"{where}: {len(position)} positions for {len(names)} joint names (mixed shapes)")
+            names, position = _checked(message, where)
             if names not in order:
                 missing = [name for name in self.names if name not in names]
                 if missing:
@@ -88,11 +115,34 @@ class JointStateBag:
                 order[names] = [names.index(name) for name in self.names]
             if count == len(rows):
                 raise ValueError(f"{episode.where}: more messages than the bag's index counts ({episode.frames})")
-            rows[count] = np.asarray(position, dtype=np.float64)[order[names]]
+            rows[count] = position[order[names]]
             count += 1
         if count != len(rows):
             raise ValueError(f"{episode.where}: {count} of the {len(rows)} messages the bag's index counts could "
                              "be read (cut short?)")
+        return rows
+
+    def _merged(self, episode: Episode, step: int) -> NDArray[np.float64]:
+        """Every `step`-th frame of the latest positions of all joints, from the first complete one."""
+        rows = np.empty((math.ceil(episode.frames / step), len(self.names)))
+        column = {name: c for c, name in enumerate(self.names)}
+        latest = np.empty(len(self.names))
+        count = 0
+        for i, (_, message) in enumerate(self._messages(1)):
+            names, position = _checked(message, f"{episode.where}: message {i}")
+            if frozenset(names) not in self._sets:
+                raise ValueError(f"{episode.where}: message {i} names {list(names)}, none of the joint sets the "
+                                 f"topic's publishers name ({[sorted(s, key=column.__getitem__) for s in self._sets]})")
+            latest[[column[name] for name in names]] = position
+            frame = i - self._first
+            if frame >= 0 and frame % step == 0:
+                if count == len(rows):
+                    raise ValueError(f"{episode.where}: more messages than the bag's index counts")
+                rows[count] = latest
+                count += 1
+        if count != len(rows):
+            raise ValueError(f"{episode.where}: {count} of the {len(rows)} frames the bag's index counts could be "
+                             "read (cut short?)")
         return rows
 
     def __enter__(self) -> JointStateBag:
@@ -100,3 +150,11 @@ class JointStateBag:
 
     def __exit__(self, kind: type[BaseException] | None, err: BaseException | None, tb: TracebackType | None) -> None:
         self._reader.close()
+
+
+def _checked(message: Any, where: str) -> tuple[tuple[str, ...], NDArray[np.float64]]:
+    """A JointState message's names and positions, as many of each (else a ValueError at `where`)."""
+    names, position = tuple(message.name), np.asarray(message.position, dtype=np.float64)
+    if len(position) != len(names):
+        raise ValueError(f"{where}: {len(position)} positions for {len(names)} joint names (mixed shapes)")
+    return names, position
