@@ -55,6 +55,38 @@ def write_lerobot(folder: Path, episodes: list[np.ndarray], names: tuple[str, ..
     return folder
 
 
+def write_lerobot_v3(folder: Path, episodes: list[np.ndarray], names: tuple[str, ...] = NAMES, *,
+                     per_file: int = 2, key: str = "observation.state") -> Path:
+    """A LeRobot v3.0 dataset: `per_file` episodes to a data file (file-000, file-001, … of
+    chunk-000), and the episode table saying which file holds each and its global row range."""
+    width = episodes[0].shape[1]
+    features = {key: {"dtype": "float32", "shape": [width], "names": list(names)},
+                "episode_index": {"dtype": "int64", "shape": [1], "names": None}}
+    info = {"codebase_version": "v3.0", "robot_type": "test", "fps": 30, "chunks_size": 1000,
+            "total_episodes": len(episodes), "total_frames": sum(len(e) for e in episodes),
+            "data_path": "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet", "features": features}
+    (folder / "meta" / "episodes" / "chunk-000").mkdir(parents=True)
+    (folder / "data" / "chunk-000").mkdir(parents=True)
+    (folder / "meta" / "info.json").write_text(json.dumps(info))
+    rows, start = [], 0
+    for file_index in range(0, len(episodes), per_file):
+        part = list(enumerate(episodes))[file_index:file_index + per_file]
+        frames = np.concatenate([e for _, e in part])
+        offsets = pa.array(np.arange(len(frames) + 1, dtype=np.int32) * width)
+        table = pa.table({key: pa.ListArray.from_arrays(offsets, pa.array(frames.ravel(), type=pa.float32())),
+                          "frame_index": pa.array(np.concatenate([np.arange(len(e)) for _, e in part]), pa.int64()),
+                          "episode_index": pa.array(np.concatenate([np.full(len(e), i) for i, e in part]), pa.int64()),
+                          "index": pa.array(np.arange(start, start + len(frames)), pa.int64())})
+        pq.write_table(table, folder / "data" / "chunk-000" / f"file-{file_index // per_file:03d}.parquet")
+        for i, e in part:
+            rows.append({"episode_index": i, "tasks": ["reach"], "length": len(e), "data/chunk_index": 0,
+                         "data/file_index": file_index // per_file, "dataset_from_index": start,
+                         "dataset_to_index": start + len(e)})
+            start += len(e)
+    pq.write_table(pa.Table.from_pylist(rows), folder / "meta" / "episodes" / "chunk-000" / "file-000.parquet")
+    return folder
+
+
 def write_episode(folder: Path, index: int, frames, *, key: str = "observation.state",
                   value_type: pa.DataType = pa.float32()) -> Path:
     if isinstance(frames, np.ndarray):  # as LeRobot writes it: a list column
@@ -144,6 +176,7 @@ def main() -> None:
     episodes = arm_episodes(args.frames)
     frames = np.concatenate(episodes)
     for what, write in (("lerobot", lambda: write_lerobot(args.out / "lerobot", episodes, list(ARM))),
+                        ("lerobot_v3", lambda: write_lerobot_v3(args.out / "lerobot_v3", episodes, ARM, per_file=50)),
                         ("robomimic.hdf5", lambda: write_hdf5(args.out / "robomimic.hdf5", episodes, ARM)),
                         ("joint_states.bag", lambda: write_bag(args.out / "joint_states.bag", frames, ARM, ros=1)),
                         ("joint_states_ros2", lambda: write_bag(args.out / "joint_states_ros2", frames, ARM, ros=2))):

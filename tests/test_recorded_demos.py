@@ -13,6 +13,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 
 from latentrl import Demonstrations, Task, cli, load_demos, save_demos
@@ -20,7 +21,7 @@ from latentrl.recorded import frames as frames_module
 from latentrl.recorded.options import joint_map
 from latentrl.recorded.sampling import farthest_points
 
-from recorded_writers import NAMES, episodes_of, write_bag, write_episode, write_hdf5, write_lerobot
+from recorded_writers import NAMES, episodes_of, write_bag, write_episode, write_hdf5, write_lerobot, write_lerobot_v3
 
 ROOT = Path(__file__).resolve().parents[1]
 RNG = np.random.default_rng(0)
@@ -51,6 +52,47 @@ def test_lerobot_float32_names_as_v2_0_dict_and_another_state_column(tmp_path):
     with pytest.raises(ValueError, match=r"info.json: no feature 'observation.state'; its float features are "
                                          r"\['action', 'observation.joints', 'timestamp'\]"):
         load_demos(tmp_path / "ds")
+
+
+def test_a_lerobot_v3_dataset_loads_each_episode_from_the_file_its_table_names(tmp_path):
+    """v3.0 packs several episodes into one data file; the episode table says which file holds
+    each and how many frames it has: the same postures, episodes and frames as v2.1's layout."""
+    episodes = episodes_of((5, 7, 4, 6, 3))
+    write_lerobot_v3(tmp_path / "v3", episodes, per_file=2)
+    write_lerobot(tmp_path / "v2", episodes)
+    v3, v2 = load_demos(tmp_path / "v3"), load_demos(tmp_path / "v2")
+    np.testing.assert_array_equal(v3.postures, np.concatenate(episodes).astype(np.float32))
+    np.testing.assert_array_equal(v3.postures, v2.postures)
+    assert v3.joint_names == NAMES and v3.episodes.tolist() == v2.episodes.tolist()
+    assert v3.frames.tolist() == v2.frames.tolist()
+    sampled = load_demos(tmp_path / "v3", max_postures=10)
+    assert len(sampled.postures) == 10 and set(sampled.episodes.tolist()) <= set(range(5))
+
+
+def test_a_broken_lerobot_v3_dataset_is_named(tmp_path):
+    episodes = episodes_of((5, 7, 4))
+    root = write_lerobot_v3(tmp_path / "short", episodes)
+    table = root / "meta" / "episodes" / "chunk-000" / "file-000.parquet"
+    rows = pq.read_table(table).to_pylist()
+    rows[1]["dataset_to_index"] += 2  # the table claims 9 frames for episode 1
+    pq.write_table(pa.Table.from_pylist(rows), table)
+    with pytest.raises(ValueError, match=r"file-000\.parquet: 7 rows of episode_index 1, where the episode table gives 9"):
+        load_demos(root)
+    root = write_lerobot_v3(tmp_path / "nocol", episodes)
+    pq.write_table(pa.Table.from_pylist([{"episode_index": 0}]), root / "meta" / "episodes" / "chunk-000" / "file-000.parquet")
+    with pytest.raises(ValueError, match=r"file-000\.parquet: no columns \['data/chunk_index'"):
+        load_demos(root)
+    root = write_lerobot_v3(tmp_path / "escape", episodes)
+    info = json.loads((root / "meta" / "info.json").read_text())
+    (root / "meta" / "info.json").write_text(json.dumps({**info, "data_path": "../../x/file-{file_index:03d}.parquet"}))
+    with pytest.raises(ValueError, match=r"data_path '\.\./\.\./x/file-\{file_index:03d\}\.parquet' leads out of the dataset"):
+        load_demos(root)
+    (root / "meta" / "info.json").write_text(json.dumps({**info, "data_path": "data/{episode_chunk}.parquet"}))
+    with pytest.raises(ValueError, match=r"data_path 'data/\{episode_chunk\}\.parquet' is no v3 data file template"):
+        load_demos(root)
+    root = write_lerobot_v3(tmp_path / "key", episodes)
+    with pytest.raises(ValueError, match=r"no feature 'observation\.effort'; its float features are \['observation\.state'\]"):
+        load_demos(root, key="observation.effort")
 
 
 @pytest.mark.parametrize("names_on", ["dataset", "data", "given"])

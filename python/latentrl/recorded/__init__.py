@@ -3,7 +3,7 @@ or ROS 2 bag of ``sensor_msgs/JointState``. `latentrl.load_demos` and every ``--
 through this package; each format's library is an optional extra, imported only when a file of
 that format is read:
 
-- a LeRobot dataset (v2.x): a folder with ``meta/info.json`` and ``data/chunk-*/episode_*.parquet``
+- a LeRobot dataset (v2.x or v3.0): a folder with ``meta/info.json`` and ``data/chunk-*/*.parquet``
   (``pip install 'latentrl[lerobot]'``, pyarrow);
 - HDF5 in the robomimic layout, ``data/demo_*/obs/<key>`` (``.hdf5`` or ``.h5``;
   ``pip install 'latentrl[hdf5]'``, h5py);

@@ -1,6 +1,9 @@
-"""A LeRobot dataset (v2.x layout) as a `Recording`: ``meta/info.json`` names the features (the
-state one's ``names`` are the joints), ``data/chunk-*/episode_*.parquet`` hold one episode each.
-Needs pyarrow (``pip install 'latentrl[lerobot]'``)."""
+"""A LeRobot dataset as a `Recording`: ``meta/info.json`` names the features (the state one's
+``names`` are the joints). In the v2.x layout ``data/chunk-*/episode_*.parquet`` hold one episode
+each; in the v3.0 layout ``data/chunk-*/file-*.parquet`` hold many, and
+``meta/episodes/chunk-*/file-*.parquet`` say which file holds each episode and how many frames it
+has (its rows in that file are those of its ``episode_index``). Needs pyarrow
+(``pip install 'latentrl[lerobot]'``)."""
 
 from __future__ import annotations
 
@@ -18,6 +21,10 @@ from latentrl.recorded.libraries import needs
 
 DEFAULT_KEY = "observation.state"
 EPISODE_FILE = re.compile(r"episode_(\d+)\.parquet")
+V3_EPISODE_COLUMNS = ("episode_index", "data/chunk_index", "data/file_index", "dataset_from_index", "dataset_to_index")
+"""The columns of a v3.0 dataset's episode table this reader needs."""
+V3_DATA_PATH = "data/chunk-{chunk_index:03d}/file-{file_index:03d}.parquet"
+"""LeRobot v3.0's data file template, when info.json gives none."""
 
 
 def feature_names(names: Any, where: str) -> tuple[str, ...] | None:
@@ -47,10 +54,10 @@ class LeRobotDataset:
             raise ValueError(f"{info_path}: not valid JSON ({err})") from err
         features = info.get("features") if isinstance(info, dict) else None
         if not isinstance(features, dict):
-            raise ValueError(f"{info_path}: no features (a LeRobot v2.x info.json has a features table)")
-        if str(info.get("codebase_version", "v2")).startswith("v3"):
-            raise ValueError(f"{info_path}: a LeRobot {info['codebase_version']} dataset; latentrl reads the v2.x layout "
-                             "(one data/chunk-*/episode_*.parquet per episode)")
+            raise ValueError(f"{info_path}: no features (a LeRobot info.json has a features table)")
+        self._v3 = str(info.get("codebase_version", "v2")).startswith("v3")
+        self._files: dict[int, Path] = {}  # episode index → its data file
+        self._table: tuple[Path, Any] | None = None  # the last data file read (a v3.0 file holds many episodes)
         feature = features.get(self.field)
         if not isinstance(feature, dict):
             vectors = sorted(k for k, v in features.items() if isinstance(v, dict) and v.get("dtype") in ("float32", "float64"))
@@ -64,7 +71,7 @@ class LeRobotDataset:
         if shape is not None and list(shape) != [len(names)]:
             raise ValueError(f"{where}: shape {shape} for {len(names)} joint names {list(names)}")
         self.names = names
-        self.episodes = self._episodes(info, info_path)
+        self.episodes = self._v3_episodes(info, info_path) if self._v3 else self._episodes(info, info_path)
 
     def _episodes(self, info: dict[str, Any], info_path: Path) -> tuple[Episode, ...]:
         files = {}
@@ -82,6 +89,42 @@ class LeRobotDataset:
             if parquet.schema_arrow.get_field_index(self.field) < 0:
                 raise ValueError(f"{file}: no column {self.field!r}; it has {parquet.schema_arrow.names}")
             episodes.append(Episode(index, parquet.metadata.num_rows, str(file)))
+            self._files[index] = file
+        return tuple(episodes)
+
+    def _v3_episodes(self, info: dict[str, Any], info_path: Path) -> tuple[Episode, ...]:
+        """The episodes of a v3.0 dataset from its episode table, each with its data file."""
+        tables = sorted(self.path.glob("meta/episodes/chunk-*/file-*.parquet"))
+        if not tables:
+            raise ValueError(f"{info_path}: a LeRobot v3 dataset without its episode table "
+                             f"({self.path / 'meta/episodes/chunk-*/file-*.parquet'})")
+        rows: list[dict[str, Any]] = []
+        for table in tables:
+            names = self._open(table).schema_arrow.names
+            missing = [c for c in V3_EPISODE_COLUMNS if c not in names]
+            if missing:
+                raise ValueError(f"{table}: no columns {missing} (a LeRobot v3 episode table has {list(V3_EPISODE_COLUMNS)})")
+            rows += self._open(table).read(columns=list(V3_EPISODE_COLUMNS)).to_pylist()
+        expected = info.get("total_episodes")
+        if isinstance(expected, int) and expected != len(rows):
+            raise ValueError(f"{info_path}: total_episodes is {expected}, but its episode table lists {len(rows)}")
+        template, checked, episodes = info.get("data_path") or V3_DATA_PATH, set(), []
+        for row in sorted(rows, key=lambda r: r["episode_index"]):
+            index = row["episode_index"]
+            try:
+                file = self.path / template.format(chunk_index=row["data/chunk_index"], file_index=row["data/file_index"])
+            except (KeyError, IndexError, ValueError, TypeError) as err:
+                raise ValueError(f"{info_path}: data_path {template!r} is no v3 data file template ({err!r})") from err
+            if not file.resolve().is_relative_to(self.path.resolve()):
+                raise ValueError(f"{info_path}: data_path {template!r} leads out of the dataset, to {file}")
+            if file not in checked:
+                schema = self._open(file).schema_arrow
+                missing = [c for c in (self.field, "episode_index") if schema.get_field_index(c) < 0]
+                if missing:
+                    raise ValueError(f"{file}: no column {missing[0]!r}; it has {schema.names}")
+                checked.add(file)
+            self._files[index] = file
+            episodes.append(Episode(index, row["dataset_to_index"] - row["dataset_from_index"], str(file)))
         return tuple(episodes)
 
     def _open(self, file: Path) -> Any:
@@ -93,11 +136,8 @@ class LeRobotDataset:
     def read(self, episode: Episode, step: int) -> NDArray[np.float64]:
         """Every `step`-th frame of the episode's state column; a frame whose length is not the
         number of joints is a ValueError naming the file, column and frame."""
-        where = f"{episode.where}: column {self.field!r}"
-        try:
-            column = self._open(Path(episode.where)).read(columns=[self.field]).column(0).combine_chunks()
-        except self._pa.ArrowException as err:
-            raise ValueError(f"{where}: cannot be read (cut short?): {err}") from err
+        where = f"{episode.where}: {f'episode {episode.index}, ' if self._v3 else ''}column {self.field!r}"
+        column = self._column(episode, where)
         if not self._pa.types.is_list(column.type) and not self._pa.types.is_fixed_size_list(column.type) \
                 and not self._pa.types.is_large_list(column.type):
             raise ValueError(f"{where}: holds {column.type}, not a list of joint values per frame")
@@ -109,6 +149,25 @@ class LeRobotDataset:
                              f"(one per joint: {list(self.names)})")
         values = np.asarray(column.flatten().to_numpy(zero_copy_only=False), dtype=np.float64)
         return values.reshape(len(column), len(self.names))[::step]
+
+    def _column(self, episode: Episode, where: str) -> Any:
+        """The episode's state column: its file's (v2.x), or its rows of its file's (v3.0), which
+        must be as many as the episode table gives."""
+        file = self._files[episode.index]
+        columns = [self.field, "episode_index"] if self._v3 else [self.field]
+        try:
+            if self._table is None or self._table[0] != file:
+                self._table = (file, self._open(file).read(columns=columns))
+            table = self._table[1]
+            if not self._v3:
+                return table.column(0).combine_chunks()
+            rows = np.flatnonzero(table.column(1).to_numpy(zero_copy_only=False) == episode.index)
+        except self._pa.ArrowException as err:
+            raise ValueError(f"{where}: cannot be read (cut short?): {err}") from err
+        if len(rows) != episode.frames:
+            raise ValueError(f"{episode.where}: {len(rows)} rows of episode_index {episode.index}, where the episode "
+                             f"table gives {episode.frames} frames")
+        return table.column(0).take(rows).combine_chunks()
 
     def __enter__(self) -> LeRobotDataset:
         return self
