@@ -20,6 +20,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 from rosbags.rosbag1 import Writer as Bag1Writer
+from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Bag2Writer
 from rosbags.typesys import Stores, get_typestore
 
@@ -125,14 +126,16 @@ def write_hdf5(path: Path, episodes: list[np.ndarray], names: tuple[str, ...] | 
 
 
 def write_bag(path: Path, frames: np.ndarray, names=NAMES, *, ros: int = 1, topic: str = "/joint_states",
-              shuffle: bool = False, message=None) -> Path:
-    """A ROS 1 bag or a ROS 2 bag folder of sensor_msgs/JointState; with `shuffle`, each message
-    lists its joints in another order; `message(i, names, positions)` may change a message."""
+              shuffle: bool = False, message=None, mcap: bool = False) -> Path:
+    """A ROS 1 bag or a ROS 2 bag folder (SQLite, or with `mcap` MCAP) of sensor_msgs/JointState;
+    with `shuffle`, each message lists its joints in another order; `message(i, names, positions)`
+    may change a message."""
     store = get_typestore(Stores.ROS1_NOETIC if ros == 1 else Stores.ROS2_HUMBLE)
     joint_state, header, time = (store.types[t] for t in
                                  ("sensor_msgs/msg/JointState", "std_msgs/msg/Header", "builtin_interfaces/msg/Time"))
     serialize = store.serialize_ros1 if ros == 1 else store.serialize_cdr
-    writer = Bag1Writer(path) if ros == 1 else Bag2Writer(path, version=9)
+    writer = Bag1Writer(path) if ros == 1 else \
+        Bag2Writer(path, version=9, storage_plugin=StoragePlugin.MCAP if mcap else StoragePlugin.SQLITE3)
     rng = np.random.default_rng(1)
     with writer:
         connection = writer.add_connection(topic, joint_state.__msgtype__, typestore=store)

@@ -104,10 +104,12 @@ def test_a_robomimic_hdf5_loads_its_names_from_an_attribute_or_the_caller(tmp_pa
     assert demos.joint_names == NAMES and demos.episodes.tolist() == [0] * 5 + [1] * 7 + [2] * 4
 
 
-@pytest.mark.parametrize("ros", [1, 2])
+@pytest.mark.parametrize("ros", [1, 2, "2-mcap"])
 def test_a_ros_bag_of_joint_states_loads_each_message_by_its_names(tmp_path, ros):
     frames = episodes_of((40,))[0]
-    path = write_bag(bag_path(tmp_path, ros), frames, ros=ros, shuffle=True)
+    mcap = ros == "2-mcap"
+    path = write_bag(bag_path(tmp_path, 2 if mcap else ros), frames, ros=2 if mcap else ros, shuffle=True, mcap=mcap)
+    assert not mcap or (path / "demo_bag.mcap").is_file()
     demos = load_demos(path, expected_joints=NAMES)
     np.testing.assert_array_equal(demos.postures, frames)
     assert demos.episodes.tolist() == [0] * 40 and demos.frames.tolist() == list(range(40))
