@@ -90,6 +90,26 @@ def test_a_broken_lerobot_v3_dataset_is_named(tmp_path):
     (root / "meta" / "info.json").write_text(json.dumps({**info, "data_path": "data/{episode_chunk}.parquet"}))
     with pytest.raises(ValueError, match=r"data_path 'data/\{episode_chunk\}\.parquet' is no v3 data file template"):
         load_demos(root)
+    for name, change, said in (
+            ("null", {"dataset_from_index": None}, r"\['dataset_from_index'\] must be integers >= 0"),
+            ("twice", {"episode_index": 0}, r"the episode table lists episodes \[0\] more than once"),
+            ("nofile", {"data/file_index": 7}, r"episode 1's data file .*file-007\.parquet is missing")):
+        root = write_lerobot_v3(tmp_path / name, episodes)
+        table = root / "meta" / "episodes" / "chunk-000" / "file-000.parquet"
+        rows = pq.read_table(table).to_pylist()
+        rows[1].update(change)
+        pq.write_table(pa.Table.from_pylist(rows), table)
+        with pytest.raises(ValueError, match=said):
+            load_demos(root)
+    # The Hugging Face cache: every file of the snapshot a link to a blob outside its folder.
+    built, snapshot, blobs = write_lerobot_v3(tmp_path / "built", episodes), tmp_path / "snapshot", tmp_path / "blobs"
+    blobs.mkdir()
+    for n, file in enumerate(sorted(p for p in built.rglob("*") if p.is_file())):
+        file.rename(blobs / str(n))
+        link = snapshot / file.relative_to(built)
+        link.parent.mkdir(parents=True, exist_ok=True)
+        link.symlink_to(blobs / str(n))
+    np.testing.assert_array_equal(load_demos(snapshot).postures, np.concatenate(episodes).astype(np.float32))
     root = write_lerobot_v3(tmp_path / "key", episodes)
     with pytest.raises(ValueError, match=r"no feature 'observation\.effort'; its float features are \['observation\.state'\]"):
         load_demos(root, key="observation.effort")

@@ -8,7 +8,9 @@ has (its rows in that file are those of its ``episode_index``). Needs pyarrow
 from __future__ import annotations
 
 import json
+import os
 import re
+from collections import Counter
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -108,6 +110,14 @@ class LeRobotDataset:
         expected = info.get("total_episodes")
         if isinstance(expected, int) and expected != len(rows):
             raise ValueError(f"{info_path}: total_episodes is {expected}, but its episode table lists {len(rows)}")
+        for row in rows:
+            bad = [c for c in V3_EPISODE_COLUMNS if not (isinstance(row[c], int) and row[c] >= 0)]
+            if bad or row["dataset_to_index"] < row["dataset_from_index"]:
+                raise ValueError(f"{tables[0].parent.parent}: episode table row {row}: "
+                                 + (f"{bad} must be integers >= 0" if bad else "dataset_to_index is below dataset_from_index"))
+        repeated = sorted(i for i, n in Counter(r["episode_index"] for r in rows).items() if n > 1)
+        if repeated:
+            raise ValueError(f"{tables[0].parent.parent}: the episode table lists episodes {repeated} more than once")
         template, checked, episodes = info.get("data_path") or V3_DATA_PATH, set(), []
         for row in sorted(rows, key=lambda r: r["episode_index"]):
             index = row["episode_index"]
@@ -115,8 +125,11 @@ class LeRobotDataset:
                 file = self.path / template.format(chunk_index=row["data/chunk_index"], file_index=row["data/file_index"])
             except (KeyError, IndexError, ValueError, TypeError) as err:
                 raise ValueError(f"{info_path}: data_path {template!r} is no v3 data file template ({err!r})") from err
-            if not file.resolve().is_relative_to(self.path.resolve()):
+            # Lexically, not resolved: the Hugging Face cache links every file to a blob outside the folder.
+            if not Path(os.path.normpath(file)).is_relative_to(os.path.normpath(self.path)):
                 raise ValueError(f"{info_path}: data_path {template!r} leads out of the dataset, to {file}")
+            if not file.is_file():
+                raise ValueError(f"{self.path}: episode {index}'s data file {file} is missing")
             if file not in checked:
                 schema = self._open(file).schema_arrow
                 missing = [c for c in (self.field, "episode_index") if schema.get_field_index(c) < 0]
