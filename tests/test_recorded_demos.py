@@ -138,7 +138,7 @@ def test_a_ros_bag_of_joint_states_loads_each_message_by_its_names(tmp_path, ros
 
 
 @pytest.mark.parametrize("ros", [1, 2])
-def test_two_publishers_on_one_topic_are_merged_into_frames_of_the_latest_positions(tmp_path, ros):
+def test_two_publishers_on_one_topic_are_merged_into_frames_of_the_latest_positions(tmp_path, ros, monkeypatch):
     """An arm driver (NAMES) and a gripper driver (one joint, every third message) on
     /joint_states: each frame holds every joint's latest position, from the first message at
     which both have spoken; a message naming part of one publisher's joints is refused."""
@@ -158,6 +158,11 @@ def test_two_publishers_on_one_topic_are_merged_into_frames_of_the_latest_positi
     demos = load_demos(path, expected_joints=[*arm, *grip])
     np.testing.assert_array_equal(demos.postures, np.array(expected))
     assert demos.frames.tolist() == list(range(28))
+    monkeypatch.setattr(frames_module, "MAX_RECORDED_VALUES", 60)  # past the cap: every 2nd merged frame
+    every_other = load_demos(path, expected_joints=[*arm, *grip], max_postures=14)
+    np.testing.assert_array_equal(every_other.postures, np.array(expected)[::2])
+    assert every_other.frames.tolist() == list(range(0, 28, 2))
+    monkeypatch.undo()
 
     def dropping(i, names, positions):
         names, positions = publisher(i, names, positions)
