@@ -229,24 +229,18 @@ mod tests {
 
     #[test]
     fn the_folder_follows_the_first_usable_variable() {
-        let home = ("HOME", "/home/u");
-        assert_eq!(folder(&[home]), Some("/home/u/.cache/latentrl/hulls".into()));
-        assert_eq!(
-            folder(&[home, ("XDG_CACHE_HOME", "/c")]),
-            Some("/c/latentrl/hulls".into())
-        );
-        assert_eq!(
-            folder(&[home, ("XDG_CACHE_HOME", "rel/c")]),
-            Some("/home/u/.cache/latentrl/hulls".into())
-        );
-        assert_eq!(
-            folder(&[home, ("XDG_CACHE_HOME", "")]),
-            Some("/home/u/.cache/latentrl/hulls".into())
-        );
-        assert_eq!(
-            folder(&[home, ("LATENTRL_CACHE_DIR", "mine")]),
-            Some("mine/hulls".into())
-        );
+        let at_home = "/home/u/.cache/latentrl/hulls";
+        let cases = [
+            (None, at_home),
+            (Some(("XDG_CACHE_HOME", "/c")), "/c/latentrl/hulls"),
+            (Some(("XDG_CACHE_HOME", "rel/c")), at_home), // relative: invalid, as the XDG spec says
+            (Some(("XDG_CACHE_HOME", "")), at_home),
+            (Some(("LATENTRL_CACHE_DIR", "mine")), "mine/hulls"),
+        ];
+        for (var, expected) in cases {
+            let vars: Vec<_> = [("HOME", "/home/u")].into_iter().chain(var).collect();
+            assert_eq!(folder(&vars), Some(expected.into()), "{var:?}");
+        }
         assert_eq!(folder(&[]), None);
     }
 }
