@@ -26,6 +26,9 @@ from sklearn.pipeline import Pipeline, make_pipeline  # noqa: E402
 from sklearn.preprocessing import StandardScaler  # noqa: E402
 from sklearn.utils.estimator_checks import (  # noqa: E402
     check_dataframe_column_names_consistency,
+    check_global_output_transform_pandas,
+    check_set_output_transform,
+    check_set_output_transform_pandas,
     check_transformer_get_feature_names_out,
     check_transformer_get_feature_names_out_pandas,
     parametrize_with_checks,
@@ -83,14 +86,23 @@ def test_sklearn_estimator_checks(estimator: Any, check: Any) -> None:
         check_dataframe_column_names_consistency,
         check_transformer_get_feature_names_out,
         check_transformer_get_feature_names_out_pandas,
+        check_set_output_transform,
+        check_set_output_transform_pandas,
+        check_global_output_transform_pandas,
     ],
     ids=lambda c: c.__name__,
 )
 def test_sklearn_feature_name_checks(estimator: Any, check: Any) -> None:
-    """Checks that scikit-learn runs on its own estimators but not in `parametrize_with_checks`."""
-    if pd is None and check is not check_transformer_get_feature_names_out:
+    """Checks that scikit-learn runs on its own estimators but not in `parametrize_with_checks`:
+    column names, and the output API (`set_output`, which `Pipeline.set_output` calls)."""
+    if pd is None and check not in (check_transformer_get_feature_names_out, check_set_output_transform):
         pytest.skip("this check builds DataFrames: pandas is not installed")
-    check(type(estimator).__name__, estimator)
+    with warnings.catch_warnings():
+        if check in (check_set_output_transform_pandas, check_global_output_transform_pandas):
+            # they fit to a DataFrame and transform an array, and the other way round, on which
+            # scikit-learn's own estimators warn as ours do
+            warnings.filterwarnings("ignore", "X (does not have valid|has) feature names", UserWarning)
+        check(type(estimator).__name__, estimator)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -129,6 +141,28 @@ def test_pipeline_scaler_then_estimator(estimator: Any, postures: Any) -> None:
     assert twin[-1] is not model and twin[-1].get_params() == model.get_params()
     assert not hasattr(twin[-1], "n_features_in_")
     np.testing.assert_array_equal(twin.fit(postures).transform(postures), latent)
+
+
+@pytest.mark.parametrize(
+    "estimator", [PCA(), GPLVM(max_iter=50, random_state=0)], ids=lambda e: type(e).__name__
+)
+def test_a_pipeline_set_to_pandas_output_gives_latent_dataframes(estimator: Any, postures: Any) -> None:
+    """`Pipeline.set_output(transform="pandas")` reached the estimator as an AttributeError-free
+    no-op before: scikit-learn refused the pipeline. Now the latent points come as a DataFrame
+    (its columns `get_feature_names_out`, the input's index), kept by pickling; inside the
+    package nothing changes (`_encode` stays an array)."""
+    frame = postures.set_axis(range(100, 160))
+    pipe = make_pipeline(StandardScaler(), estimator).set_output(transform="pandas").fit(frame)
+    prefix = type(estimator).__name__.lower()
+    for latent in (pipe.transform(frame), pipe.fit_transform(frame)):
+        assert isinstance(latent, pd.DataFrame) and list(latent.columns) == [f"{prefix}0", f"{prefix}1"]
+        assert latent.index.tolist() == list(range(100, 160))
+    model = pipe[-1]
+    np.testing.assert_array_equal(pickle.loads(pickle.dumps(model)).transform(frame).to_numpy(),
+                                  model.transform(frame).to_numpy())
+    assert isinstance(model.set_output(transform="default").transform(frame), np.ndarray)
+    with pytest.raises(ValueError, match=r"set_output: transform must be one of \['default', 'pandas', 'polars'\]"):
+        model.set_output(transform="numpy")
 
 
 def test_grid_search_over_n_components(postures: Any) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import inspect
 import json
+import sys
 import warnings
 from typing import Any, ClassVar, Self
 
@@ -86,6 +87,10 @@ def _plain_number(value: Any) -> Any:
     raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
 
 
+OUTPUTS = ("default", "pandas", "polars")
+"""What `set_output(transform=...)` takes, as scikit-learn's."""
+
+
 class Estimator:
     """scikit-learn's estimator contract without depending on it: `__init__` only stores
     its parameters; `get_params`/`set_params`, `__repr__`, pickling and NPZ save/load; the
@@ -112,13 +117,44 @@ class Estimator:
         """Fits the model to postures `X` (N, D); returns self."""
         raise NotImplementedError
 
-    def transform(self, X: Any) -> NDArray[np.float64]:
-        """Latent points (M, d) of postures `X` (M, D)."""
+    def transform(self, X: Any) -> Any:
+        """Latent points (M, d) of postures `X` (M, D): an ndarray, or a DataFrame (`set_output`)."""
         raise NotImplementedError
 
-    def fit_transform(self, X: Any, y: Any = None) -> NDArray[np.float64]:
-        """Latent points (N, d) of the postures `X` (N, D) it is fitted to."""
+    def fit_transform(self, X: Any, y: Any = None) -> Any:
+        """Latent points (N, d) of the postures `X` (N, D) it is fitted to (as `transform`'s)."""
         raise NotImplementedError
+
+    def set_output(self, *, transform: str | None = None) -> Self:
+        """scikit-learn's output API (`Pipeline.set_output` calls it): ``"pandas"`` or ``"polars"``
+        makes `transform` and `fit_transform` return a DataFrame with the columns
+        `get_feature_names_out()` (pandas: the index of a DataFrame given); ``"default"``
+        ndarrays, unless scikit-learn is imported and its `transform_output` is set; None
+        changes nothing. Kept by pickling and `clone`, not by `save` (a setting, not the fit)."""
+        if transform is None:
+            return self
+        if transform not in OUTPUTS:
+            raise ValueError(f"set_output: transform must be one of {list(OUTPUTS)} or None, got {transform!r}")
+        self._sklearn_output_config = {"transform": transform}  # the attribute scikit-learn's clone copies
+        return self
+
+    def _output(self, latent: NDArray[np.float64], X: Any) -> Any:
+        """`latent`, the latent points of postures `X`, in the form `set_output` asked for."""
+        how = getattr(self, "_sklearn_output_config", {}).get("transform", "default")
+        sklearn = sys.modules.get("sklearn")
+        if how == "default" and sklearn is not None:
+            how = sklearn.get_config().get("transform_output", "default")
+        columns = [str(name) for name in self.get_feature_names_out()]
+        if how == "pandas":
+            import pandas as pd
+
+            index = X.index if isinstance(X, pd.DataFrame) else None
+            return pd.DataFrame(latent, columns=columns, index=index, copy=False)
+        if how == "polars":
+            import polars as pl
+
+            return pl.DataFrame(latent, schema=columns, orient="row")
+        return latent
 
     def inverse_transform(self, Z: Any) -> NDArray[np.float64]:
         """Postures (M, D) decoded from latent points `Z` (M, d)."""
@@ -265,15 +301,18 @@ class Estimator:
         self._build()
 
     def __getstate__(self) -> dict[str, Any]:
-        state = {"params": self.get_params()}
+        state: dict[str, Any] = {"params": self.get_params()}
         if all(hasattr(self, name) for name in self._saved):
             state["fitted"] = self._fitted_state()
+        if hasattr(self, "_sklearn_output_config"):
+            state["output"] = self._sklearn_output_config["transform"]
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.set_params(**state["params"])
         if "fitted" in state:
             self._restore(state["fitted"])
+        self.set_output(transform=state.get("output"))
 
     def save(self, path: PathLike) -> None:
         """Writes the parameters and fitted state to an NPZ file at `path` (atomically; the name

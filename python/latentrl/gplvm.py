@@ -179,7 +179,8 @@ class GPLVM(Estimator):
     `X` may be a pandas DataFrame: `transform` then wants the columns of `fit` in the same
     order, and raises a ValueError naming the unseen, missing or misplaced ones (it warns
     if only one of the two had column names). `transform`, `inverse_transform` and
-    `predict_variance` return ndarrays, `inverse_transform`'s columns in the order of
+    `predict_variance` return ndarrays (`transform` and `fit_transform` DataFrames after
+    `set_output(transform="pandas")`), `inverse_transform`'s columns in the order of
     `feature_names_in_`; `get_feature_names_out` names the latent axes ``gplvm0``, …
     """
 
@@ -261,7 +262,7 @@ class GPLVM(Estimator):
         if inducing is None and len(X) > COSTLY_EXACT_FIT:
             _warn_of_cost(X, d, max_iter)
         pca = PCA(d).fit(X)
-        start = pca.transform(X) / (np.sqrt(pca.explained_variance_[0]) or 1.0)
+        start = pca._encode(X) / (np.sqrt(pca.explained_variance_[0]) or 1.0)
         centred = X - pca.mean_
         log_theta = initial_log_theta(start, centred)
         rng = np.random.default_rng(self.random_state)
@@ -435,16 +436,15 @@ class GPLVM(Estimator):
     def _n_features_out(self) -> int:
         return int(self.Z_.shape[1])
 
-    def fit_transform(self, X: Any, y: Any = None) -> NDArray[np.float64]:
-        """`fit(X)`, then the fitted latent points `Z_` (not re-encoded)."""
-        Z: NDArray[np.float64] = self.fit(X).Z_
-        return Z
+    def fit_transform(self, X: Any, y: Any = None) -> Any:
+        """`fit(X)`, then the fitted latent points `Z_` (not re-encoded), as `transform` returns them."""
+        return self._output(self.fit(X).Z_, X)
 
-    def transform(self, X: Any, method: str | None = None) -> NDArray[np.float64]:
+    def transform(self, X: Any, method: str | None = None) -> Any:
         """Encodes postures `X` (M, D), an array or DataFrame, to latent points (M, d),
         with the out-of-sample GP (`method="gp"`) or the iterative projection; default: the
-        `encoder` parameter."""
-        return self._encode(self._check_X(X), method)
+        `encoder` parameter. An ndarray, or a DataFrame (`set_output`)."""
+        return self._output(self._encode(self._check_X(X), method), X)
 
     def _encode(self, X: Any, method: str | None = None) -> NDArray[np.float64]:
         """`transform` of postures whose columns are those of the fit, unnamed, without the

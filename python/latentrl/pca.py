@@ -55,7 +55,8 @@ class PCA(Estimator):
     `parametrize_with_checks` (tests/test_sklearn.py). `X` may be a pandas DataFrame:
     `transform` then wants the columns of `fit` in the same order, and raises a ValueError
     naming the unseen, missing or misplaced ones (it warns if only one of the two had
-    column names). `transform` and `inverse_transform` return ndarrays, the latter's
+    column names). `transform` and `inverse_transform` return ndarrays (`transform` a
+    DataFrame after `set_output(transform="pandas")`, as in a pipeline set so), the latter's
     columns in the order of `feature_names_in_`; `get_feature_names_out` names the latent
     axes ``pca0``, ``pca1``, …
     """
@@ -103,9 +104,10 @@ class PCA(Estimator):
     def _n_features_out(self) -> int:
         return int(self.components_.shape[0])
 
-    def transform(self, X: Any) -> NDArray[np.float64]:
-        """Latent points (N, d) of postures `X` (N, D), an array or DataFrame."""
-        return self._encode(self._check_X(X))
+    def transform(self, X: Any) -> Any:
+        """Latent points (N, d) of postures `X` (N, D), an array or DataFrame: an ndarray, or a
+        DataFrame (`set_output`)."""
+        return self._output(self._encode(self._check_X(X)), X)
 
     def _encode(self, X: Any) -> NDArray[np.float64]:
         """`transform` of postures whose columns are those of the fit, unnamed, without the
@@ -116,7 +118,7 @@ class PCA(Estimator):
         latent: NDArray[np.float64] = (X - self.mean_) @ self.components_.T
         return latent
 
-    def fit_transform(self, X: Any, y: Any = None) -> NDArray[np.float64]:
+    def fit_transform(self, X: Any, y: Any = None) -> Any:
         """`fit(X)`, then `transform(X)`."""
         return self.fit(X).transform(X)
 

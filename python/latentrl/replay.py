@@ -100,7 +100,7 @@ def recorded(experiment: str, preset: Any, run_dir: Path, rows: NDArray[np.float
         fitted = exp1.fit(preset, run_dir)
         plant, learner = exp1.configs(preset)
         hands = np.concatenate([rows.reshape(len(rows), 2, 2), np.zeros((len(rows), 2, 1))], axis=2)
-        return Recorded(title, hands, fitted.model.transform(rows), weights, fitted.low, fitted.high, fitted.model,
+        return Recorded(title, hands, fitted.model._encode(rows), weights, fitted.low, fitted.high, fitted.model,
                         learner, toy=plant)
     task, model, (low, high) = run_setup(experiment, preset, run_dir)
     return robot_episode(task, model, low, high, rows, weights, title, view)

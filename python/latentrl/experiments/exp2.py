@@ -179,7 +179,7 @@ def _fig5(preset: Exp2Preset, fitted: Fitted, out: Path) -> None:
 
     rng = np.random.default_rng(preset.seed)
     pca = PCA(n_components=2).fit(fitted.demos)
-    methods = (("PCA", pca, pca.transform(fitted.demos)), ("GPLVM", fitted.model, fitted.model.Z_))
+    methods = (("PCA", pca, pca._encode(fitted.demos)), ("GPLVM", fitted.model, fitted.model.Z_))
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.5))
     for ax, (name, model, latent) in zip(axes, methods):
         low, high = latent_box(latent, preset.latent_margin)

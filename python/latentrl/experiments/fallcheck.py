@@ -121,7 +121,7 @@ def fit_coders(preset: FallCheckPreset | None = None) -> tuple[NDArray[np.float6
     pca = PCA(n_components=2).fit(X)
     gplvm = GPLVM(n_components=2, random_state=p.random_state).fit(X)
     raw: dict[str, tuple[NDArray[np.float64], Any]] = {
-        "PCA": (pca.transform(X), pca.inverse_transform),
+        "PCA": (pca._encode(X), pca.inverse_transform),
         "GPLVM": (gplvm.Z_, gplvm.inverse_transform),
         "joint": (X, lambda z: np.asarray(z, dtype=float)),
     }

@@ -170,7 +170,7 @@ def _evaluate(
     preset: Table1Preset,
 ) -> dict[str, Any]:
     """Reconstruction error and constraint shares of one fitted model (PCA or GPLVM)."""
-    recon = model.inverse_transform(model.transform(test))
+    recon = model.inverse_transform(model._encode(test))
     hands_true = arms_fk(test) if joint else test
     hands_recon = arms_fk(recon) if joint else recon
     out: dict[str, Any] = {
@@ -231,7 +231,7 @@ def run_trial(preset: Table1Preset, trial: int) -> dict[str, Any]:
             ).fit(demos)
             fit_seconds = time.perf_counter() - t0
             fits[label][space] = {
-                "PCA": _evaluate(pca, pca.transform(demos), test[space], unit, joint, preset),
+                "PCA": _evaluate(pca, pca._encode(demos), test[space], unit, joint, preset),
                 "GPLVM": {
                     **_evaluate(gplvm, gplvm.Z_, test[space], unit, joint, preset),
                     "fit": {
