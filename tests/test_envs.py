@@ -371,3 +371,17 @@ def test_a_success_truncates_and_does_not_terminate():
     assert not terminated and not truncated and info == {"end_reason": None, "reached": True}
     _, _, terminated, truncated, info = env.step(zero)
     assert not terminated and truncated and info == {"end_reason": "success", "reached": True}
+
+
+def test_the_time_limit_recipe_for_a_direct_task_env_is_what_a_registered_id_is():
+    """`TaskEnv(task)` built directly has no time limit (Gymnasium's convention); its docstring's
+    TimeLimit recipe truncates where `gym.make` of the registered id does."""
+    task = Task.shipped("two_arms").replace({"episode.max_steps": 3})
+    demos = shipped_demos("two_arms")
+    made = gym.make("latentrl/TwoArms-v0", task=task, demos=demos, max_episode_steps=3)
+    wrapped = gym.wrappers.TimeLimit(TaskEnv(task, demos), task.to_dict()["episode"]["max_steps"])
+    for env in (made, wrapped):
+        env.reset(seed=0)
+        ends = [env.step(np.zeros(env.action_space.shape, np.float32))[2:4] for _ in range(3)]
+        assert ends == [(False, False), (False, False), (False, True)]
+    assert gym.spec("latentrl/TwoArms-v0").max_episode_steps == Task.shipped("two_arms").to_dict()["episode"]["max_steps"]

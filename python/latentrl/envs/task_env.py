@@ -55,6 +55,9 @@ class TaskEnv(gym.Env[Obs, Obs]):
     effectors are within the target's reach radius. Truncated by the registration's
     `max_episode_steps` (the task's `episode.max_steps`), and with `info["end_reason"]`
     "success" when the task's `target.hold_steps` held (not a terminal state: bootstrap it).
+    Built directly, as for your own task, nothing else truncates (Gymnasium's convention: the
+    time limit is a wrapper): `gymnasium.wrappers.TimeLimit(TaskEnv(task),
+    task.to_dict()["episode"]["max_steps"])` is what the registered ids are.
 
     ## Arguments
     `task` (a Task or a shipped task's name), `demos` (N, D in `task.joint_names` order, or a
