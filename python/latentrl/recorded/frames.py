@@ -100,13 +100,17 @@ def renamed(names: Sequence[str], joint_map: Mapping[str, str]) -> tuple[str, ..
     """`names` with `joint_map`'s renames (old → new; new "": the column is left out, its name
     ""); a name to rename that is not there, or two joints that end up with one name, is a
     ValueError."""
+    unnamed = [c for c, name in enumerate(names) if not name]
+    if unnamed:  # "" would read as a column the map leaves out: dropped without a word
+        raise ValueError(f"recorded joints {unnamed} (counting from 0) have an empty name, in {list(names)}; "
+                         "give the joint names (--joint-names a,b,…) or fix the recorder's")
     absent = sorted(set(joint_map) - set(names))
     if absent:
         raise ValueError(f"the joint map renames {absent}, which are not among the joints {list(names)}")
     new = tuple(joint_map.get(name, name) for name in names)
     twice = sorted({name for name in new if name and new.count(name) > 1})
     if twice:
-        raise ValueError(f"after the joint map, joints {twice} name two columns each")
+        raise ValueError(f"{'after the joint map, ' if joint_map else ''}joints {twice} name two columns each")
     return new
 
 
