@@ -115,6 +115,51 @@ def test_a_broken_lerobot_v3_dataset_is_named(tmp_path):
         load_demos(root, key="observation.effort")
 
 
+def test_recorded_joint_names_empty_or_twice_are_refused_as_such(tmp_path):
+    """An empty recorded name read as a column a joint map leaves out (dropped without a word);
+    a name twice blamed a joint map nobody gave."""
+    write_lerobot(tmp_path / "empty", episodes_of(), ["shoulder", "", "wrist"])
+    with pytest.raises(ValueError, match=r"recorded joints \[1\] \(counting from 0\) have an empty name"):
+        load_demos(tmp_path / "empty")
+    write_lerobot(tmp_path / "twice", episodes_of(), ["joint", "joint", "wrist"])
+    with pytest.raises(ValueError, match=r"\(observation.state\): joints \['joint'\] name two columns each"):
+        load_demos(tmp_path / "twice")
+
+
+def test_a_one_joint_lerobot_feature_stored_as_a_plain_column_loads(tmp_path):
+    """LeRobot writes a feature of shape (1,) as a scalar column, not a list (helper-32's sweep:
+    refused as "holds float")."""
+    episodes = episodes_of((4, 6), width=1)
+    write_lerobot(tmp_path / "ds", episodes, ("gripper",))
+    for index, frames in enumerate(episodes):
+        path = tmp_path / "ds" / "data" / "chunk-000" / f"episode_{index:06d}.parquet"
+        pq.write_table(pq.read_table(path).set_column(0, "observation.state", pa.array(frames[:, 0], pa.float32())), path)
+    np.testing.assert_array_equal(load_demos(tmp_path / "ds").postures, np.concatenate(episodes).astype(np.float32))
+
+
+def test_an_hdf5_demo_naming_its_joints_in_another_order_is_read_in_the_first_ones(tmp_path):
+    """Each demo's dataset may carry its own joint names: a demo in another order was read by
+    position, its joints swapped without a word (helper-32's sweep); other names are refused,
+    and two groups of one episode index (demo_1, demo_01) too."""
+    episodes = episodes_of((4, 5))
+    path = write_hdf5(tmp_path / "d.hdf5", episodes)
+    with h5py.File(path, "r+") as f:
+        dataset = f["data/demo_1/obs/robot0_joint_pos"]
+        dataset[...] = episodes[1][:, ::-1]
+        dataset.attrs["joint_names"] = list(NAMES[::-1])
+    np.testing.assert_array_equal(load_demos(path).postures, np.concatenate(episodes))
+    with h5py.File(path, "r+") as f:
+        f["data/demo_1/obs/robot0_joint_pos"].attrs["joint_names"] = ["wrist", "elbow", "knee"]
+    with pytest.raises(ValueError, match=r"/data/demo_1/obs/robot0_joint_pos names its joints \['wrist', 'elbow', "
+                                         r"'knee'\], not the recording's \['shoulder', 'elbow', 'wrist'\]"):
+        load_demos(path)
+    path = write_hdf5(tmp_path / "twice.hdf5", episodes_of((4, 5, 6)))
+    with h5py.File(path, "r+") as f:
+        f.move("data/demo_2", "data/demo_01")
+    with pytest.raises(ValueError, match=r"data/demo_01 and data/demo_1 are both episode 1: rename one"):
+        load_demos(path)
+
+
 @pytest.mark.parametrize("names_on", ["dataset", "data", "given"])
 def test_a_robomimic_hdf5_loads_its_names_from_an_attribute_or_the_caller(tmp_path, names_on):
     episodes = episodes_of()
@@ -181,17 +226,20 @@ def test_a_bag_is_read_as_a_subscriber_sees_it(tmp_path, ros, recwarn):
     """Publishers that start late, publish velocities only, or republish every joint beside a
     driver of some (helper-32's sweep: each was refused before, with no option to read it)."""
     frames = episodes_of((30,), width=4)[0]
-    late = lambda i, n, p: (n[:3], p[:3]) if i < 10 else (n, p)  # the gripper's first message is message 10
+    def late(i, n, p):
+        return (n[:3], p[:3]) if i < 10 else (n, p)  # the gripper's first message is message 10
     path = write_bag(bag_path(tmp_path, ros), frames, [*NAMES, "gripper"], ros=ros, message=late)
     demos = load_demos(path)
     np.testing.assert_array_equal(demos.postures, frames[10:])
     assert demos.frames.tolist() == list(range(20))
     assert any("its first 10 messages come before joint 'gripper' is first named (message 10)" in str(w.message)
                for w in recwarn)
-    velocity = lambda i, n, p: (["wheel"], np.zeros(0)) if i % 4 == 3 else (n, p)  # names, no positions
+    def velocity(i, n, p):
+        return (["wheel"], np.zeros(0)) if i % 4 == 3 else (n, p)  # names, no positions
     path = write_bag(tmp_path / ("v.bag" if ros == 1 else "v_bag"), frames[:, :3], ros=ros, message=velocity)
     np.testing.assert_array_equal(load_demos(path).postures, frames[[i for i in range(30) if i % 4 != 3], :3])
-    empty_first = lambda i, n, p: ([], np.zeros(0)) if i == 0 else (n, p)
+    def empty_first(i, n, p):
+        return ([], np.zeros(0)) if i == 0 else (n, p)
     path = write_bag(tmp_path / ("e.bag" if ros == 1 else "e_bag"), frames[:, :3], ros=ros, message=empty_first)
     np.testing.assert_array_equal(load_demos(path).postures, frames[1:, :3])
 
@@ -491,6 +539,12 @@ def test_folders_that_are_no_recording_are_named(tmp_path):
     (tmp_path / "bag" / "bag_0.db3").write_bytes(b"x")
     with pytest.raises(ValueError, match=r"a ROS 2 bag is read as its folder \(with metadata.yaml\): give .*bag$"):
         load_demos(tmp_path / "bag" / "bag_0.db3")
+    (tmp_path / "bag" / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
+    with pytest.raises(ValueError, match=r"metadata.yaml: a ROS 2 bag is read as its folder .*: give .*bag$"):
+        load_demos(tmp_path / "bag" / "metadata.yaml")
+    write_lerobot(tmp_path / "ds", episodes_of())
+    with pytest.raises(ValueError, match=r"info.json: a LeRobot dataset is read as its folder .*: give .*ds$"):
+        load_demos(tmp_path / "ds" / "meta" / "info.json")
     with pytest.raises(FileNotFoundError):
         load_demos(tmp_path / "absent.hdf5")
 

@@ -40,8 +40,10 @@ def recording_kind(path: Path) -> str | None:
         raise ValueError(f"{path}: a folder, but neither a LeRobot dataset (no meta/info.json) nor a "
                          "ROS 2 bag (no metadata.yaml); demonstrations are " + KINDS + ", or .csv, .json, .npz")
     suffix = path.suffix.lower()
-    if suffix in (".db3", ".mcap"):
+    if suffix in (".db3", ".mcap") or (path.name == "metadata.yaml" and path.is_file()):
         raise ValueError(f"{path}: a ROS 2 bag is read as its folder (with metadata.yaml): give {path.parent}")
+    if path.name == "info.json" and path.parent.name == "meta" and path.is_file():
+        raise ValueError(f"{path}: a LeRobot dataset is read as its folder (with meta/info.json): give {path.parent.parent}")
     if suffix in HDF5_SUFFIXES:
         return "hdf5"
     if suffix == ".bag":

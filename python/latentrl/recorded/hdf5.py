@@ -1,6 +1,7 @@
 """An HDF5 file in the robomimic layout as a `Recording`: one group ``data/demo_<i>`` per episode,
 the joint positions in ``data/demo_<i>/obs/<key>`` (N, D). Joint names: a ``joint_names``
-attribute on that dataset or on ``data``, else given. Needs h5py (``pip install 'latentrl[hdf5]'``)."""
+attribute on that dataset or on ``data``, else given; a demo whose dataset names its joints in
+another order is read in the first one's order. Needs h5py (``pip install 'latentrl[hdf5]'``)."""
 
 from __future__ import annotations
 
@@ -38,6 +39,7 @@ class RobomimicFile:
         try:
             self.episodes, datasets = self._episodes()
             self.names = joint_names or self._recorded_names(datasets)
+            self._order = {} if joint_names else self._orders()
             if datasets and datasets[0].shape[1] != len(self.names):
                 raise ValueError(f"{path}: {self.field} has {datasets[0].shape[1]} values per frame, "
                                  f"for {len(self.names)} joint names {list(self.names)}")
@@ -52,6 +54,10 @@ class RobomimicFile:
         demos = sorted((int(m.group(1)), name) for name in data.keys() if (m := DEMO.fullmatch(name)))
         if not demos:
             raise ValueError(f"{self.path}: no episodes (no data/demo_<i> groups; data has {sorted(data.keys())})")
+        twice = [(i, a, b) for (i, a), (j, b) in zip(demos, demos[1:]) if i == j]
+        if twice:
+            index, first, second = twice[0]
+            raise ValueError(f"{self.path}: data/{first} and data/{second} are both episode {index}: rename one")
         self._data: dict[int, Any] = {}
         episodes, width = [], None
         for index, name in demos:
@@ -79,10 +85,27 @@ class RobomimicFile:
         raise ValueError(f"{self.path}: no {NAMES_ATTRIBUTE!r} attribute on data/demo_*/obs/{self.field} or data; "
                          "give the joint names (--joint-names a,b,…)")
 
+    def _orders(self) -> dict[int, list[int]]:
+        """Per demo whose dataset has its own joint names in another order than `names`, the
+        columns that put them in that order; other names are a ValueError naming the demo."""
+        orders = {}
+        for index, dataset in self._data.items():
+            if NAMES_ATTRIBUTE not in dataset.attrs:
+                continue
+            own = _names(dataset.attrs[NAMES_ATTRIBUTE])
+            if own == self.names:
+                continue
+            if sorted(own) != sorted(self.names) or len(set(own)) != len(own):
+                raise ValueError(f"{self.path}: {dataset.name} names its joints {list(own)}, not the recording's "
+                                 f"{list(self.names)} in some order")
+            orders[index] = [own.index(name) for name in self.names]
+        return orders
+
     def read(self, episode: Episode, step: int) -> NDArray[np.float64]:
-        """Every `step`-th frame of the episode's dataset."""
+        """Every `step`-th frame of the episode's dataset, its columns in the order of `names`."""
         try:
-            return np.asarray(self._data[episode.index][::step], dtype=np.float64)
+            frames = np.asarray(self._data[episode.index][::step], dtype=np.float64)
+            return frames[:, self._order[episode.index]] if episode.index in self._order else frames
         except OSError as err:
             raise ValueError(f"{episode.where}: cannot be read (cut short?): {err}") from err
 

@@ -151,6 +151,10 @@ class LeRobotDataset:
         number of joints is a ValueError naming the file, column and frame."""
         where = f"{episode.where}: {f'episode {episode.index}, ' if self._v3 else ''}column {self.field!r}"
         column = self._column(episode, where)
+        if len(self.names) == 1 and (self._pa.types.is_floating(column.type) or self._pa.types.is_integer(column.type)):
+            if column.null_count:  # LeRobot writes a one-value feature as a plain column
+                raise ValueError(f"{where}: frame {column.is_null().index(True).as_py()} has no value")
+            return np.asarray(column.to_numpy(zero_copy_only=False), dtype=np.float64)[::step, None]
         if not self._pa.types.is_list(column.type) and not self._pa.types.is_fixed_size_list(column.type) \
                 and not self._pa.types.is_large_list(column.type):
             raise ValueError(f"{where}: holds {column.type}, not a list of joint values per frame")
