@@ -44,6 +44,17 @@ def test_a_training_episode_of_exp2_becomes_an_mp4(runs):
     assert iio.improps(out).shape[1:] == (480, 960, 3)
 
 
+@pytest.mark.parametrize("width, height", [(322, 161), (320, 160)])
+def test_an_mp4_keeps_the_frame_size_asked_for(tmp_path, width, height):
+    """imageio resized MP4 frames to a multiple of 16 (`--width 322`: 336 × 176); now they keep
+    their size, an odd side padded by one pixel (H.264 needs even sides)."""
+    from latentrl.replay import write_video
+
+    frames = [np.full((height, width, 3), 40 * i, np.uint8) for i in range(3)]
+    write_video(iter(frames), tmp_path / "v.mp4", fps=5)
+    assert iio.improps(tmp_path / "v.mp4").shape[1:] == (height + height % 2, width, 3)
+
+
 @pytest.mark.parametrize("args, says", [
     (["--test", "5"], "--test 5: the run recorded test episodes 0..1"),
     (["--episode", "7"], "--episode 7: the run recorded training episodes [0, 1, 2, 3]"),

@@ -199,7 +199,8 @@ def frame_steps(steps: int, max_frames: int) -> NDArray[np.int64]:
 def write_video(frames: Iterable[NDArray[np.uint8]], out: Path, fps: int) -> None:
     """Writes `frames` (at least one) to `out` (GIF or MP4 by suffix) as they come, through a
     temporary file, so a failed or interrupted write leaves nothing half-written. Memory stays
-    bounded: an MP4's frames stream to ffmpeg (imageio's writer), a GIF keeps each frame
+    bounded: an MP4's frames stream to ffmpeg (imageio's writer; at their size, an odd side
+    padded by one pixel, as H.264 needs even ones), a GIF keeps each frame
     quantised to its 256-colour palette (Pillow, one byte per pixel) until it is saved. A write
     that fails (a full disk) is an OSError naming `out` (`atomic_path`, issue #38)."""
     with atomic_path(out) as temp:
@@ -212,10 +213,12 @@ def write_video(frames: Iterable[NDArray[np.uint8]], out: Path, fps: int) -> Non
             return
         import imageio.v2 as imageio
 
-        writer = imageio.get_writer(temp, format="FFMPEG", fps=fps)
+        # H.264 in yuv420p needs even sides; imageio's default would resize every frame to a
+        # multiple of 16 (322 wide became 336): an odd side gets one edge pixel instead.
+        writer = imageio.get_writer(temp, format="FFMPEG", fps=fps, macro_block_size=1)
         with writer:  # streams each frame to ffmpeg's stdin
             for frame in frames:
-                writer.append_data(frame)
+                writer.append_data(np.pad(frame, ((0, frame.shape[0] % 2), (0, frame.shape[1] % 2), (0, 0)), mode="edge"))
 
 
 def run_setup(experiment: str, preset: Any, run_dir: Path) -> tuple[Any, Any, tuple[NDArray[np.float64], NDArray[np.float64]]]:
