@@ -96,6 +96,31 @@ class LeRobotDataset:
 
     def _v3_episodes(self, info: dict[str, Any], info_path: Path) -> tuple[Episode, ...]:
         """The episodes of a v3.0 dataset from its episode table, each with its data file."""
+        template, checked, episodes = info.get("data_path") or V3_DATA_PATH, set(), []
+        for row in sorted(self._episode_table(info, info_path), key=lambda r: r["episode_index"]):
+            index = row["episode_index"]
+            try:
+                file = self.path / template.format(chunk_index=row["data/chunk_index"], file_index=row["data/file_index"])
+            except (KeyError, IndexError, ValueError, TypeError) as err:
+                raise ValueError(f"{info_path}: data_path {template!r} is no v3 data file template ({err!r})") from err
+            # Lexically, not resolved: the Hugging Face cache links every file to a blob outside the folder.
+            if not Path(os.path.normpath(file)).is_relative_to(os.path.normpath(self.path)):
+                raise ValueError(f"{info_path}: data_path {template!r} leads out of the dataset, to {file}")
+            if not file.is_file():
+                raise ValueError(f"{self.path}: episode {index}'s data file {file} is missing")
+            if file not in checked:
+                schema = self._open(file).schema_arrow
+                missing = [c for c in (self.field, "episode_index") if schema.get_field_index(c) < 0]
+                if missing:
+                    raise ValueError(f"{file}: no column {missing[0]!r}; it has {schema.names}")
+                checked.add(file)
+            self._files[index] = file
+            episodes.append(Episode(index, row["dataset_to_index"] - row["dataset_from_index"], str(file)))
+        return tuple(episodes)
+
+    def _episode_table(self, info: dict[str, Any], info_path: Path) -> list[dict[str, Any]]:
+        """The rows of a v3.0 dataset's episode table (its files in order), checked: the columns
+        this reader needs, integers, each episode once, as many as `total_episodes`."""
         tables = sorted(self.path.glob("meta/episodes/chunk-*/file-*.parquet"))
         if not tables:
             raise ValueError(f"{info_path}: a LeRobot v3 dataset without its episode table "
@@ -118,27 +143,7 @@ class LeRobotDataset:
         repeated = sorted(i for i, n in Counter(r["episode_index"] for r in rows).items() if n > 1)
         if repeated:
             raise ValueError(f"{tables[0].parent.parent}: the episode table lists episodes {repeated} more than once")
-        template, checked, episodes = info.get("data_path") or V3_DATA_PATH, set(), []
-        for row in sorted(rows, key=lambda r: r["episode_index"]):
-            index = row["episode_index"]
-            try:
-                file = self.path / template.format(chunk_index=row["data/chunk_index"], file_index=row["data/file_index"])
-            except (KeyError, IndexError, ValueError, TypeError) as err:
-                raise ValueError(f"{info_path}: data_path {template!r} is no v3 data file template ({err!r})") from err
-            # Lexically, not resolved: the Hugging Face cache links every file to a blob outside the folder.
-            if not Path(os.path.normpath(file)).is_relative_to(os.path.normpath(self.path)):
-                raise ValueError(f"{info_path}: data_path {template!r} leads out of the dataset, to {file}")
-            if not file.is_file():
-                raise ValueError(f"{self.path}: episode {index}'s data file {file} is missing")
-            if file not in checked:
-                schema = self._open(file).schema_arrow
-                missing = [c for c in (self.field, "episode_index") if schema.get_field_index(c) < 0]
-                if missing:
-                    raise ValueError(f"{file}: no column {missing[0]!r}; it has {schema.names}")
-                checked.add(file)
-            self._files[index] = file
-            episodes.append(Episode(index, row["dataset_to_index"] - row["dataset_from_index"], str(file)))
-        return tuple(episodes)
+        return rows
 
     def _open(self, file: Path) -> Any:
         try:
