@@ -400,3 +400,16 @@ def test_a_latent_margin_that_overflows_the_box_is_refused_naming_it():
     assert [b.tolist() for b in latent_box(latent, 0.5)] == [[-1.0, -2.0], [3.0, 2.0]]
     with pytest.raises(ValueError, match=r"run.latent_margin = 1e\+308 widens the latent box beyond the largest float"):
         latent_box(latent, 1e308)
+
+
+def test_a_rollout_line_says_which_endings_came_after_reaching_the_target() -> None:
+    """A policy that arrives and stays ends by timeout: "ends: timeout 39" read as a policy that
+    mostly timed out (helper-33's figure review: 35 of the glass arm's 39 had reached it)."""
+    from latentrl.rollout_summary import format_rollout, rollout_summary
+    from latentrl.task import end_reasons
+
+    names = end_reasons()
+    ends = np.array([names.index("timeout")] * 3 + [names.index("obstacle")])
+    summary = rollout_summary(ends, np.array([True, True, False, False]), np.zeros(4), Task.shipped("two_arms"))
+    assert summary["ends_after_reaching"]["timeout"] == 2 and summary["ends_after_reaching"]["obstacle"] == 0
+    assert format_rollout(summary).endswith("ends: timeout 3 (2 after reaching), obstacle 1")

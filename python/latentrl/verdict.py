@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from latentrl.task import end_counts, end_reasons
+from latentrl.rollout_summary import format_ends
 from latentrl.train import format_rollout
 
 LEARNT = 0.8
@@ -60,6 +61,7 @@ class Verdict:
     verdict: str
     rollouts: dict[str, dict[str, Any]]
     late_ends: dict[str, int]
+    late_ends_reached: dict[str, int]
     reach_late: float
     rising: bool
     next: list[str] = field(default_factory=list)
@@ -67,12 +69,13 @@ class Verdict:
     def to_dict(self) -> dict[str, Any]:
         """As written to report.json."""
         return {"verdict": self.verdict, "rollouts": self.rollouts, "late_ends": self.late_ends,
-                "reach_late": self.reach_late, "rising": self.rising, "next": self.next}
+                "late_ends_reached": self.late_ends_reached, "reach_late": self.reach_late, "rising": self.rising,
+                "next": self.next}
 
     def __str__(self) -> str:
         lines = [f"verdict: {self.verdict}"]
         lines += [f"  {kind:8s} {format_rollout(summary)}" for kind, summary in self.rollouts.items()]
-        ends = ", ".join(f"{n} {c}" for n, c in self.late_ends.items() if c)
+        ends = format_ends(self.late_ends, self.late_ends_reached)
         lines.append(f"  last fifth of training: reached {self.reach_late:.0%}{' (still rising)' if self.rising else ''};"
                      f" ends: {ends}")
         lines += [f"  next: {step}" for step in self.next]
@@ -116,7 +119,9 @@ def timeout_advice(policy: Any, returns: NDArray[np.float64]) -> str:
                 "their errors; more --episodes with --episode.stop-window 0 may help a little (the zoo's "
                 "snake, 8 trials: 42 % greedy at the defaults, 49 % with 6000 episodes)")
     return (f"failing greedy rollouts time out away from the target (mean reward {per_step:.2f} per step): "
-            "where they wander (failures.png) the learnt value is flat; more --episodes, or starts through there")
+            "the learnt value is flat where they wander (latentrl rollout DIR --out DIR/rollout keeps their "
+            "paths, latentrl replay DIR/rollout --episode N draws one; failures.png is where trial 0's late "
+            "training episodes failed); more --episodes, or starts through there")
 
 
 def stop_advice(reached: NDArray[np.bool_], runs: NDArray[np.int_]) -> str | None:
@@ -130,7 +135,7 @@ def stop_advice(reached: NDArray[np.bool_], runs: NDArray[np.int_]) -> str | Non
     behind = (runs < reached.shape[1]) & (late < late.max() - RISING)
     if not behind.any():
         return None
-    return (f"the stopping rule ended {int(behind.sum())} of {len(runs)} trials at "
+    return (f"the stopping rule ended {int(behind.sum())} of {len(runs)} trials below the best one, at "
             f"{', '.join(str(int(r)) for r in runs[behind])} episodes, reaching the target in "
             f"{', '.join(f'{v:.0%}' for v in late[behind])} of their last tenth, where another trial reached "
             f"{late.max():.0%}: --episode.stop-window 0 runs every episode of the budget")
@@ -163,7 +168,7 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
         verdict = f"{'still' if rising else 'stopped'} improving below the target"
     names = end_reasons()
     late = last(ends, fifth)
-    late_ends = end_counts(late)
+    late_ends, late_ends_reached = end_counts(late), end_counts(late[last(reached, fifth).astype(bool)])
     steps: list[str] = []
     if verdict != "learnt":
         greedy = runs_of["greedy"]
@@ -186,4 +191,4 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
             steps.append("run latentrl check: its target and paths findings say whether the target can be reached")
         if findings is not None:
             steps += [f"{f.name}: {f.fix}" for f in findings.findings if f.verdict != "ok" and f.fix]
-    return Verdict(verdict, rollouts, late_ends, reach_late, bool(rising), steps)
+    return Verdict(verdict, rollouts, late_ends, late_ends_reached, reach_late, bool(rising), steps)
