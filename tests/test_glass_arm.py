@@ -226,7 +226,8 @@ def test_the_failures_figure_shows_the_last_episodes_a_stopped_trial_ran(monkeyp
     arrays = {"latent": np.full((1, budget), np.nan), "latent_end": ends, "latent_reached": np.zeros((1, budget), bool),
               "latent_mean_state": means, "latent_weights": np.zeros((1, 4))}
     training.failures(arrays, "stopped", np.zeros(2), np.ones(2), None, {}, tmp_path)
-    assert titles == ["stopped: where the last 100 episodes of trial 0 failed (100)"]
+    assert titles == ["stopped: the last 100 training episodes of trial 0: 100 never reached the target,\n"
+                      "marked at each one's mean latent state by how it ended"]
 
 
 def test_a_stopped_trial_is_summarised_over_the_episodes_it_ran():

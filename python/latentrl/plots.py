@@ -4,7 +4,6 @@ over a latent space, saved as PNG + PDF."""
 from __future__ import annotations
 
 import io
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -35,22 +34,26 @@ def running_mean(values: NDArray[np.float64], window: int) -> NDArray[np.float64
 
 
 def learning_curves(ax: Axes, returns: Mapping[str, NDArray[np.float64]], window: int = 1) -> None:
-    """Mean ± s.d. over trials of the (running-averaged) return per episode, one line per learner;
-    a trial the stopping rule ended (NaN returns after) counts until it stopped."""
+    """Mean ± s.d. over trials of the (running-averaged) return per episode, one line per learner.
+    Where the stopping rule ended trials (NaN returns after), the mean stops at the last episode
+    every trial ran and each trial goes on as a thin line to where it stopped: a mean over fewer
+    and fewer trials would jump at each stop and narrow its band, as if learning had settled."""
     for name, per_trial in returns.items():
         smooth = running_mean(np.asarray(per_trial, dtype=float), window)
-        if np.isnan(smooth).any():
-            with warnings.catch_warnings():  # episodes no trial ran are NaN, as they should be
-                warnings.simplefilter("ignore", RuntimeWarning)
-                mean, std = np.nanmean(smooth, axis=0), np.nanstd(smooth, axis=0)
-        else:
-            mean, std = smooth.mean(axis=0), smooth.std(axis=0)
-        episodes = np.arange(1, mean.size + 1)
-        (line,) = ax.plot(episodes, mean, label=name)
-        ax.fill_between(episodes, mean - std, mean + std, color=line.get_color(), alpha=0.25, lw=0)
+        ran = np.isfinite(smooth).all(axis=0)
+        shared = int(np.argmin(ran)) if not ran.all() else ran.size  # episodes every trial ran
+        mean, std = smooth[:, :shared].mean(axis=0), smooth[:, :shared].std(axis=0)
+        episodes = np.arange(1, smooth.shape[1] + 1)
+        label = f"{name}: mean ± s.d. of {len(smooth)} trials" if len(smooth) > 1 else name
+        (line,) = ax.plot(episodes[:shared], mean, label=label)
+        ax.fill_between(episodes[:shared], mean - std, mean + std, color=line.get_color(), alpha=0.25, lw=0)
+        if shared < smooth.shape[1]:
+            for k, trial in enumerate(smooth):
+                ax.plot(episodes, trial, color=line.get_color(), lw=0.6, alpha=0.6,
+                        label=f"{name}: each trial, to where it stopped" if k == 0 else None)
     ax.set_xlabel("episode")
     ax.set_ylabel("cumulative reward" + (f" (running mean, {window})" if window > 1 else ""))
-    ax.legend()
+    ax.legend(fontsize=8)
 
 
 def hand_paths(
@@ -130,17 +133,25 @@ def latent_value_panel(
     g0, g1, value, postures, variance = latent_value_grid(weights, low, high, model, learner=learner, grid=grid)
     shape = g0.shape
     extent = (low[0], high[0], low[1], high[1])
-    image = ax.imshow(value, origin="lower", extent=extent, aspect="auto", cmap="viridis")
-    ax.figure.colorbar(image, ax=ax, label="V")
+    flat = np.ptp(value) <= 1e-9 * max(1.0, float(np.abs(value).max()))  # w₀ everywhere: rounding, not structure
+    level = float(value.mean())
+    image = ax.imshow(np.full_like(value, level) if flat else value, origin="lower", extent=extent, aspect="auto",
+                      cmap="viridis", vmin=level - 1.0 if flat else None, vmax=level + 1.0 if flat else None)
+    ax.figure.colorbar(image, ax=ax, label=f"V: expected discounted return (γ = {learner['gamma']:g})")
+    if flat:
+        ax.text(0.5, 0.5, f"V = {level:g} everywhere", transform=ax.transAxes, ha="center", va="center",
+                color="w", fontsize=11)
     shade = variance_shade(variance).reshape(shape)
     overlay = np.zeros((*shape, 4))
     overlay[..., 3] = 0.6 * shade
     ax.imshow(overlay, origin="lower", extent=extent, aspect="auto")
+    ax.fill_between([], [], color="k", alpha=0.5, label="darker: GPLVM variance (far from the demos)")
     if regions is not None:
         regions(ax, g0, g1, postures)
-    ax.plot(model.Z_[:, 0], model.Z_[:, 1], ".", color="w", ms=2)
+    ax.plot(model.Z_[:, 0], model.Z_[:, 1], ".", color="w", mec="0.4", mew=0.3, ms=3, label="demos (latent points)")
     ax.set_xlabel("z1")
     ax.set_ylabel("z2")
+    ax.legend(fontsize=7, loc="lower right")
 
 
 def latent_run_figures(

@@ -348,20 +348,26 @@ def figures(run: TrainRun, arrays: Mapping[str, np.ndarray], run_dir: Path, out:
 
     task, _, model = fitted(run, run_dir)
     learner = task.to_dict()["learner"]
+    given = ", ".join(f"{key}={value}" for key, value in run.task.items())  # the run's task flags
+    named = task.name + (f" ({given[:60]}{'…' if len(given) > 60 else ''})" if given else "")
     fig, ax = plt.subplots(figsize=(6, 4))
     learning_curves(ax, {"latent": arrays["latent"]}, window=max(1, min(100, run.episodes // 5)))
-    ax.set_title(f"{task.name}: return per episode, mean ± s.d. over trials")
+    ax.set_title(f"{named}: return per training episode", fontsize=9)
     save_figure(fig, out, "returns")
     if model.n_components_ != 2 or "latent_weights" not in arrays:
         return
     low, high = latent_box(model.Z_, run.latent_margin)
-    for name, weights in (("value_before", None), ("value_after", np.asarray(arrays["latent_weights"])[0])):
+    trials = len(arrays["latent_weights"])
+    for name, weights, title in (
+            ("value_before", None, "V before learning (the initial weight w₀)"),
+            ("value_after", np.asarray(arrays["latent_weights"])[0],
+             f"V after learning: trial 0 of {trials}, the policy act() uses (its own colour scale)")):
         fig, ax = plt.subplots(figsize=(6, 5))
         latent_value_panel(ax, weights, low, high, model, learner=learner)
-        ax.set_title(f"{task.name}: value function {name.split('_')[1]} learning")
+        ax.set_title(f"{named}:\n{title}", fontsize=9)
         save_figure(fig, out, name)
     if "latent_mean_state" in arrays:
-        failures(arrays, task.name, low, high, model, learner, out)
+        failures(arrays, named, low, high, model, learner, out)
 
 
 def failures(arrays: Mapping[str, np.ndarray], name: str, low: np.ndarray, high: np.ndarray, model: Any,
@@ -385,8 +391,8 @@ def failures(arrays: Mapping[str, np.ndarray], name: str, low: np.ndarray, high:
     for code, reason in enumerate(end_reasons()):
         mine = failed & (ends == code)
         if mine.any():
-            ax.plot(means[mine, 0], means[mine, 1], "x", ms=5, color=f"C{code}", label=f"{reason} ({mine.sum()})")
-    if failed.any():
-        ax.legend(fontsize=7, loc="upper right", title="failed, by ending", title_fontsize=7)
-    ax.set_title(f"{name}: where the last {fifth} episodes of trial {trial} failed ({failed.sum()})")
+            ax.plot(means[mine, 0], means[mine, 1], "x", ms=5, color=f"C{code}", label=f"failed: {reason} ({mine.sum()})")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)  # below: the markers stay visible
+    ax.set_title(f"{name}: the last {fifth} training episodes of trial {trial}: {failed.sum()} never reached the "
+                 "target,\nmarked at each one's mean latent state by how it ended", fontsize=9)
     save_figure(fig, out, "failures")
