@@ -310,6 +310,11 @@ def test_a_trial_that_stopped_improving_stops_and_is_read_as_it_ran(arms_model: 
     assert sum(policy.end_counts(last=5).values()) == 2 * 5
     verdict = training_verdict(policy, episodes=2)
     assert sum(verdict.late_ends.values()) == sum(max(1, int(ran.min()) // 5) for _ in ran)
+    # Each trial's share too (the pooled one hides trials far apart), in report.json and printed.
+    greedy = policy.rollout(2, policy="greedy")
+    assert verdict.per_trial["greedy"] == [float(r.mean()) for r in greedy["reached"]]
+    assert verdict.to_dict()["per_trial"] == verdict.per_trial
+    assert "  greedy per trial: " in str(verdict) and "random per trial" not in str(verdict)
 
 
 def test_timeouts_are_told_apart_by_their_reward_per_step() -> None:
@@ -378,7 +383,7 @@ def test_a_trial_stopped_in_a_dip_below_another_is_told() -> None:
     reached[2, :60:2] = True  # stopped at 60, level with the best
     runs = np.array([100, 40, 60])
     told = stop_advice(reached, runs)
-    assert told is not None and "ended 1 of 3 trials at 40 episodes" in told and "25 %" not in told
+    assert told is not None and "ended 1 of 3 trials below the best one, at 40 episodes" in told and "25 %" not in told
     assert "25%" in told and "reached 50%" in told and "--episode.stop-window 0" in told
     assert stop_advice(reached[[0, 2]], runs[[0, 2]]) is None
     assert stop_advice(reached, np.array([100, 100, 100])) is None  # none stopped

@@ -65,16 +65,22 @@ class Verdict:
     reach_late: float
     rising: bool
     next: list[str] = field(default_factory=list)
+    per_trial: dict[str, list[float]] = field(default_factory=dict)
+    """Each policy's success share per trial: trials of one run may lie far apart (the zoo's
+    snake: 0–70 % greedy), which the pooled share hides."""
 
     def to_dict(self) -> dict[str, Any]:
         """As written to report.json."""
         return {"verdict": self.verdict, "rollouts": self.rollouts, "late_ends": self.late_ends,
                 "late_ends_reached": self.late_ends_reached, "reach_late": self.reach_late, "rising": self.rising,
-                "next": self.next}
+                "next": self.next, "per_trial": self.per_trial}
 
     def __str__(self) -> str:
         lines = [f"verdict: {self.verdict}"]
         lines += [f"  {kind:8s} {format_rollout(summary)}" for kind, summary in self.rollouts.items()]
+        if len(self.per_trial.get("greedy", ())) > 1:
+            lines += [f"  {kind} per trial: {', '.join(f'{v:.0%}' for v in shares)}"
+                      for kind, shares in self.per_trial.items() if kind != "random"]
         ends = format_ends(self.late_ends, self.late_ends_reached)
         lines.append(f"  last fifth of training: reached {self.reach_late:.0%}{' (still rising)' if self.rising else ''};"
                      f" ends: {ends}")
@@ -146,6 +152,8 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
     `episodes` rollouts per trial and policy; `findings`: a `check.CheckReport` whose advice joins."""
     runs_of = {kind: policy.rollout(episodes, seed=seed, policy=kind) for kind in ("greedy", "softmax", "random")}
     rollouts = {kind: run["summary"] for kind, run in runs_of.items()}
+    per_trial = {kind: [float(v) for v in succeeded(run, rollouts[kind]).reshape(np.shape(run["reached"])).mean(axis=1)]
+                 for kind, run in runs_of.items()}  # trials × episodes
     best = max(success_share(rollouts["greedy"]), success_share(rollouts["softmax"]))
     control = success_share(rollouts["random"])
     reached = np.asarray(policy.record["reached"], dtype=bool)
@@ -191,4 +199,4 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
             steps.append("run latentrl check: its target and paths findings say whether the target can be reached")
         if findings is not None:
             steps += [f"{f.name}: {f.fix}" for f in findings.findings if f.verdict != "ok" and f.fix]
-    return Verdict(verdict, rollouts, late_ends, late_ends_reached, reach_late, bool(rising), steps)
+    return Verdict(verdict, rollouts, late_ends, late_ends_reached, reach_late, bool(rising), steps, per_trial)
