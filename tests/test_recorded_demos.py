@@ -221,6 +221,36 @@ def test_two_publishers_on_one_topic_are_merged_into_frames_of_the_latest_positi
     np.testing.assert_array_equal(load_demos(path).postures, held)
 
 
+def test_two_publishers_naming_the_same_joints_are_warned_of(tmp_path, recwarn):
+    """A stray publisher of zeros beside the driver (two ROS 1 callers, the same joints): their
+    messages interleave, which no reading rule undoes (helper-32's sweep: read without a word)."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    state, header, time = (store.types[t] for t in
+                           ("sensor_msgs/msg/JointState", "std_msgs/msg/Header", "builtin_interfaces/msg/Time"))
+
+    def write(path, callers):
+        with Writer(path) as writer:
+            connections = {c: writer.add_connection("/joint_states", state.__msgtype__, typestore=store, callerid=c)
+                           for c, _ in callers}
+            for i in range(20):
+                caller, names = callers[i % len(callers)]
+                msg = state(header=header(seq=i, stamp=time(sec=i, nanosec=0), frame_id=""), name=names,
+                            position=np.full(len(names), i / 10), velocity=np.zeros(0), effort=np.zeros(0))
+                writer.write(connections[caller], 1_000_000 * (i + 1), store.serialize_ros1(msg, state.__msgtype__))
+        return path
+
+    load_demos(write(tmp_path / "same.bag", [("/ur_driver", list(NAMES)), ("/joint_state_publisher", list(NAMES))]))
+    said = [str(w.message) for w in recwarn]
+    assert any("publishers /joint_state_publisher and /ur_driver both name joints ['elbow', 'shoulder', 'wrist']"
+               in m for m in said), said
+    recwarn.clear()
+    load_demos(write(tmp_path / "apart.bag", [("/ur_driver", list(NAMES)), ("/gripper", ["finger"])]))
+    assert not any("both name joints" in str(w.message) for w in recwarn)
+
+
 @pytest.mark.parametrize("ros", [1, 2])
 def test_a_bag_is_read_as_a_subscriber_sees_it(tmp_path, ros, recwarn):
     """Publishers that start late, publish velocities only, or republish every joint beside a

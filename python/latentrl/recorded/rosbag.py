@@ -58,6 +58,7 @@ class JointStateBag:
             if self._first:
                 warnings.warn(f"{where}: its first {self._first} messages come before joint {last!r} is first named "
                               f"(message {self._first}): left out, as frames need every joint's position", stacklevel=2)
+            self._warn_same_joints(where)
         except BaseException:
             self._reader.close()
             raise
@@ -72,6 +73,26 @@ class JointStateBag:
         if kinds:
             raise ValueError(f"{self.path}: topic {self.field} carries {kinds}, not sensor_msgs/JointState")
         return connections
+
+    def _warn_same_joints(self, where: str) -> None:
+        """Warns when two publishers of the topic (a ROS 1 bag's callers) name the same joints, as
+        a stray `joint_state_publisher` of zeros beside the driver does: their messages interleave
+        (as for a subscriber), which no reading rule can undo."""
+        named: dict[str, set[str]] = {}
+        for connection in self._connections:
+            caller = getattr(connection.ext, "callerid", None)
+            first = next(iter(self._reader.messages(connections=[connection])), None)
+            if caller is None or first is None or caller in named:
+                continue
+            named[caller] = set(self._reader.deserialize(first[2], connection.msgtype).name)
+        callers = sorted(named)
+        for k, a in enumerate(callers):
+            for b in callers[k + 1:]:
+                if named[a] & named[b]:
+                    warnings.warn(f"{where}: publishers {a} and {b} both name joints {sorted(named[a] & named[b])}: their "
+                                  "messages interleave in the frames, as a subscriber sees them; record the topic "
+                                  "with one of them", stacklevel=3)
+                    return
 
     def _messages(self, where: str) -> Iterator[tuple[int, tuple[str, ...], NDArray[np.float64]]]:
         """Each message of the topic that carries positions: its index, names and positions."""
