@@ -144,17 +144,17 @@ class Estimator:
         sklearn = sys.modules.get("sklearn")
         if how == "default" and sklearn is not None:
             how = sklearn.get_config().get("transform_output", "default")
+        if how not in ("pandas", "polars"):
+            return latent
         columns = [str(name) for name in self.get_feature_names_out()]
         if how == "pandas":
             import pandas as pd
 
             index = X.index if isinstance(X, pd.DataFrame) else None
             return pd.DataFrame(latent, columns=columns, index=index, copy=False)
-        if how == "polars":
-            import polars as pl
+        import polars as pl
 
-            return pl.DataFrame(latent, schema=columns, orient="row")
-        return latent
+        return pl.DataFrame(latent, schema=columns, orient="row")
 
     def inverse_transform(self, Z: Any) -> NDArray[np.float64]:
         """Postures (M, D) decoded from latent points `Z` (M, d)."""

@@ -246,7 +246,6 @@ def _write_rollout(args: argparse.Namespace, path: Path, policy: Any, results: d
 
 
 def _fit(args: argparse.Namespace) -> int:
-
     from latentrl import GPLVM, PCA, load_demos
     from latentrl.gplvm import name_joints
     from latentrl.recorded.options import DemoOptions

@@ -106,9 +106,9 @@ class LeRobotDataset:
             # Lexically, not resolved: the Hugging Face cache links every file to a blob outside the folder.
             if not Path(os.path.normpath(file)).is_relative_to(os.path.normpath(self.path)):
                 raise ValueError(f"{info_path}: data_path {template!r} leads out of the dataset, to {file}")
-            if not file.is_file():
-                raise ValueError(f"{self.path}: episode {index}'s data file {file} is missing")
             if file not in checked:
+                if not file.is_file():
+                    raise ValueError(f"{self.path}: episode {index}'s data file {file} is missing")
                 schema = self._open(file).schema_arrow
                 missing = [c for c in (self.field, "episode_index") if schema.get_field_index(c) < 0]
                 if missing:
@@ -127,11 +127,11 @@ class LeRobotDataset:
                              f"({self.path / 'meta/episodes/chunk-*/file-*.parquet'})")
         rows: list[dict[str, Any]] = []
         for table in tables:
-            names = self._open(table).schema_arrow.names
-            missing = [c for c in V3_EPISODE_COLUMNS if c not in names]
+            parquet = self._open(table)
+            missing = [c for c in V3_EPISODE_COLUMNS if c not in parquet.schema_arrow.names]
             if missing:
                 raise ValueError(f"{table}: no columns {missing} (a LeRobot v3 episode table has {list(V3_EPISODE_COLUMNS)})")
-            rows += self._open(table).read(columns=list(V3_EPISODE_COLUMNS)).to_pylist()
+            rows += parquet.read(columns=list(V3_EPISODE_COLUMNS)).to_pylist()
         expected = info.get("total_episodes")
         if isinstance(expected, int) and expected != len(rows):
             raise ValueError(f"{info_path}: total_episodes is {expected}, but its episode table lists {len(rows)}")

@@ -11,7 +11,7 @@ a gripper driver; a ``joint_state_publisher`` republishing every joint beside th
 read as one robot, and a message with names but no positions (a driver publishing velocities
 only) moves nothing. The topic is read once for its joint names and frame count before any frame
 is kept, so a frame count in the bag's metadata is not trusted. Two publishers naming the same
-joints interleave, as they do for a subscriber."""
+joints interleave, as they do for a subscriber: a ROS 1 bag's callers are named in a warning."""
 
 from __future__ import annotations
 
@@ -94,23 +94,27 @@ class JointStateBag:
                                   "with one of them", stacklevel=3)
                     return
 
-    def _messages(self, where: str) -> Iterator[tuple[int, tuple[str, ...], NDArray[np.float64]]]:
-        """Each message of the topic that carries positions: its index, names and positions."""
+    def _decoded(self) -> Iterator[tuple[int, Any]]:
+        """Each message of the topic, deserialized, with its index; a damaged bag, whatever rosbags
+        raises, is one ValueError naming it (`_damaged`)."""
         try:
             for i, (connection, _, raw) in enumerate(self._reader.messages(connections=self._connections)):
-                message = self._reader.deserialize(raw, connection.msgtype)
-                names, position = tuple(message.name), np.asarray(message.position, dtype=np.float64)
-                if len(position) and len(position) != len(names):
-                    raise ValueError(f"{where}: message {i}: {len(position)} positions for {len(names)} joint names "
-                                     f"({list(names)})")
-                if len(position) and not all(names):
-                    raise ValueError(f"{where}: message {i} names a joint with an empty name ({list(names)})")
-                if len(position):
-                    yield i, names, position
-        except ValueError:
-            raise
+                yield i, self._reader.deserialize(raw, connection.msgtype)
         except Exception as err:  # noqa: BLE001 (see _damaged)
             raise _damaged(self.path, err) from err
+
+    def _messages(self, where: str) -> Iterator[tuple[int, tuple[str, ...], NDArray[np.float64]]]:
+        """Each message of the topic that carries positions: its index, names and positions."""
+        for i, message in self._decoded():
+            names, position = tuple(message.name), np.asarray(message.position, dtype=np.float64)
+            if not len(position):
+                continue
+            if len(position) != len(names):
+                raise ValueError(f"{where}: message {i}: {len(position)} positions for {len(names)} joint names "
+                                 f"({list(names)})")
+            if not all(names):
+                raise ValueError(f"{where}: message {i} names a joint with an empty name ({list(names)})")
+            yield i, names, position
 
     def _scan(self, where: str) -> tuple[tuple[str, ...], int, int, str]:
         """The topic's joint names (in the order first named), the index of the first message
