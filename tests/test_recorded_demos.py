@@ -487,6 +487,16 @@ def bad_hdf5(tmp_path: Path, case: str) -> tuple[Path, dict]:
     elif case == "wrong joint names":
         write_hdf5(path, eps, ("a", "b", "c"))
         kwargs = {"expected_joints": NAMES}
+    elif case == "moved external demo":  # a demo kept in a file of its own that was not copied along
+        write_hdf5(path, eps)
+        with h5py.File(path, "r+") as f:
+            del f["data/demo_1"]
+            f["data/demo_1"] = h5py.ExternalLink("demo_1.hdf5", "/data/demo_1")
+    elif case == "broken soft link":
+        write_hdf5(path, eps)
+        with h5py.File(path, "r+") as f:
+            f["data/demo_2/obs/robot0_joint_pos"].parent.move("robot0_joint_pos", "old")
+            f["data/demo_2/obs/robot0_joint_pos"] = h5py.SoftLink("/data/demo_2/obs/gone")
     elif case == "not robomimic":
         with h5py.File(path, "w") as f:
             f.create_dataset("postures", data=np.zeros((3, 3)))
@@ -538,6 +548,10 @@ ERRORS = {  # (format, bad file) → what its error says
     ("hdf5", "missing key"): r"demos.hdf5: no dataset data/demo_0/obs/robot0_eef_pos; data/demo_0/obs has \['object', "
                               r"'robot0_joint_pos'\]",
     ("hdf5", "wrong joint names"): r"demos.hdf5 \(robot0_joint_pos\): joints \['shoulder', 'elbow', 'wrist'\] are not in",
+    ("hdf5", "moved external demo"): r"demos.hdf5: data/demo_1 links to /data/demo_1 in demo_1.hdf5, which cannot be "
+                                      r"opened \(moved or not copied\?\)",
+    ("hdf5", "broken soft link"): r"demos.hdf5: data/demo_2/obs/robot0_joint_pos links to /data/demo_2/obs/gone, "
+                                   r"which is not in the file",
     ("hdf5", "not robomimic"): r"demos.hdf5: no group 'data' \(the robomimic layout",
     ("ros", "NaN frame"): r"topic /joint_states: episode 0, frame 4, joint 'elbow': nan",
     ("ros", "empty topic"): r"topic /joint_states: episode 0 has no frames",

@@ -63,6 +63,8 @@ class RobomimicFile:
         for index, name in demos:
             field = f"data/{name}/obs/{self.field}"
             dataset = self._file.get(field)
+            if dataset is None and (link := self._broken_link(field)):
+                raise ValueError(f"{self.path}: {link}")
             if dataset is None or not hasattr(dataset, "shape"):
                 obs = self._file.get(f"data/{name}/obs")
                 keys = sorted(obs.keys()) if obs is not None and hasattr(obs, "keys") else []
@@ -77,6 +79,22 @@ class RobomimicFile:
             self._data[index] = dataset
             episodes.append(Episode(index, dataset.shape[0], f"{self.path}: {field}"))
         return tuple(episodes), [self._data[i] for i, _ in demos]
+
+    def _broken_link(self, field: str) -> str | None:
+        """The first link on the way to `field` that leads nowhere (a file moved away), said so."""
+        h5py = needs("h5py", "HDF5", "hdf5")
+        parts = field.split("/")
+        for end in range(1, len(parts) + 1):
+            where = "/".join(parts[:end])
+            if self._file.get(where) is not None:
+                continue
+            link = self._file.get(where, getlink=True)
+            if isinstance(link, h5py.ExternalLink):
+                return f"{where} links to {link.path} in {link.filename}, which cannot be opened (moved or not copied?)"
+            if isinstance(link, h5py.SoftLink):
+                return f"{where} links to {link.path}, which is not in the file"
+            return None
+        return None
 
     def _recorded_names(self, datasets: list[Any]) -> tuple[str, ...]:
         for holder in [*datasets[:1], self._file["data"]]:
