@@ -1,5 +1,6 @@
 # latentrl: every target sets itself up from a clean clone (venv, deps, native build).
-PYTHON ?= python3.11
+# Python 3.11 or newer: python3.11 where it is on the PATH, else python3 (checked before the venv is made).
+PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3 2>/dev/null || echo python3.11)
 VENV := .venv
 PY := $(VENV)/bin/python
 export CARGO_TARGET_DIR ?= $(CURDIR)/target
@@ -13,6 +14,7 @@ help: ## list the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | sed 's/:.*## /\t/'
 
 $(VENV)/.deps: pyproject.toml
+	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info < (3, 11))' 2>/dev/null || { echo "latentrl needs Python 3.11 or newer: '$(PYTHON)' is missing or older (give one: make PYTHON=/path/to/python3.11 ...)"; exit 1; }
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet "maturin>=1.9,<2" numpy scipy matplotlib "imageio>=2.31" "imageio-ffmpeg>=0.5" "moviepy>=2" "rerun-sdk>=0.23" tqdm threadpoolctl gymnasium pytest pytest-timeout hypothesis mypy scipy-stubs types-tqdm "ruff>=0.17,<0.18" scikit-learn pandas "ray>=2.9" "pyarrow>=14" "h5py>=3.10" "rosbags>=0.10"
