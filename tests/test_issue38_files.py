@@ -244,7 +244,7 @@ def test_a_tampered_cache_entry_is_not_used(tmp_path: Path, monkeypatch: pytest.
                                   [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)], 12))
     found, warnings = hull(urdf)
     assert found == {"triangles": 12, "vertices": 8, "cached": False}
-    assert len(warnings) == 1 and "is not the hull of" in warnings[0] and "lie outside its triangle" in warnings[0]
+    assert len(warnings) == 1 and "is not the hull of" in warnings[0] and "beyond it in direction" in warnings[0]
     assert hull(urdf) == ({"triangles": 12, "vertices": 8, "cached": True}, [])  # rewritten
 
 

@@ -275,6 +275,7 @@ impl UrdfModel {
         let mut warnings = scan.warnings;
         repair::unlimited_revolutes(&mut robot, &scan.no_range, &mut warnings);
         repair::split_spherical(&mut robot, &mut warnings).map_err(bad)?;
+        repair::massless_frames(&mut robot, |m, t| inertia_problem(m, t).is_some(), &mut warnings);
         let (joints, mimics) = check_robot(&robot, origin)?;
         let mut model = Self {
             robot,

@@ -254,3 +254,63 @@ fn demo_columns_take_any_order_and_check_a_mimic_against_its_leader() {
     assert!(reason(&["ja", "jc", "ja"], &[vec![0.0; 3]]).contains("\"ja\" has two columns"));
     assert_eq!(reason(&["jc", "ja"], &rows), "postures: 3 columns for 2 joint names");
 }
+
+/// A tool frame as exporters write it (onshape-to-robot, the SO-101's `gripper_frame_link`): no
+/// shape, a fixed joint, mass 1e-9 and a zero inertia. Loaded massless and folded into its
+/// parent, with a warning; it still has a pose. A heavier such link is refused as before.
+#[test]
+fn a_frame_link_of_negligible_mass_is_loaded_massless() {
+    let frame = |mass: &str| {
+        format!(
+            r#"<link name="tool"><inertial><mass value="{mass}"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial></link>
+<joint name="tool_joint" type="fixed"><parent link="a"/><child link="tool"/><origin xyz="0 0 0.3"/></joint>"#
+        )
+    };
+    let arm = format!(
+        "{}{}",
+        link("a", INERTIA),
+        hinge("j", "a", r#"<limit lower="-1" upper="1" effort="10" velocity="1"/>"#)
+    );
+    let model = load(&robot(&format!("{arm}{}", frame("1e-9"))), false).unwrap();
+    assert_eq!(model.warnings().len(), 1, "{:?}", model.warnings());
+    assert!(
+        model.warnings()[0]
+            .starts_with(r#"link "tool": a frame (no shape, on fixed joint "tool_joint") with mass 1e-9 kg"#),
+        "{:?}",
+        model.warnings()
+    );
+    let mut world = World::new(model, WorldConfig::default()).unwrap();
+    world.step(240);
+    assert!(world.joint_positions().iter().all(|q| q.is_finite()));
+    let tool = world.link_pose("tool").unwrap();
+    assert!((tool.translation.vector.z - 0.3).abs() < 1e-3, "{tool:?}");
+    // 1 g on a 2 kg robot is no frame to drop: refused as an inertia the physics cannot take.
+    let reason = refusal(&robot(&format!("{arm}{}", frame("0.001"))));
+    assert!(reason.contains(r#"link "tool" has mass 0.001"#), "{reason}");
+}
+
+/// A joint that turns a bare frame (no mass, no shape) is refused with what to do, unless a
+/// link of mass is fixed to that frame: the loader then turns that link (the Gen3 lite's
+/// `END_EFFECTOR` has neither).
+#[test]
+fn a_joint_turning_a_massless_link_is_refused_unless_a_mass_is_fixed_to_it() {
+    let bare = r#"<link name="flange"/>"#;
+    let turn = hinge(
+        "j",
+        "flange",
+        r#"<limit lower="-1" upper="1" effort="10" velocity="1"/>"#,
+    );
+    let reason = refusal(&robot(&format!("{bare}{turn}")));
+    assert!(
+        reason.contains(r#"link "flange" is moved by joint "j" but has no mass, nor has a link fixed to it"#)
+            && reason.contains(r#"make "j" type="fixed""#),
+        "{reason}"
+    );
+    let tool = format!(
+        r#"{}<joint name="mount" type="fixed"><parent link="flange"/><child link="tool"/><origin xyz="0 0 0.1"/></joint>"#,
+        link("tool", INERTIA)
+    );
+    let model = load(&robot(&format!("{bare}{turn}{tool}")), false).unwrap();
+    assert_eq!(model.joints().len(), 1);
+    steps_finite(model);
+}

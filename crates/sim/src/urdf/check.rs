@@ -245,10 +245,11 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<(Vec<J
             )));
         }
         let child = robot.links.iter().find(|l| l.name == joint.child.link);
-        if child.is_some_and(|l| l.inertial.mass.value <= 0.0) {
+        if child.is_some_and(|l| l.inertial.mass.value <= 0.0 && !carried_by_fixed_children(robot, l)) {
             return Err(bad(format!(
-                "link {:?} is moved by joint {:?} but has no mass",
-                joint.child.link, joint.name
+                "link {:?} is moved by joint {:?} but has no mass, nor has a link fixed to it: give it an \
+                 <inertial> (what the joint turns: a flange, a tool), or make {:?} type=\"fixed\" if no task moves it",
+                joint.child.link, joint.name, joint.name
             )));
         }
         let positive = |v: f64| (v.is_finite() && v > 0.0).then_some(v);
@@ -271,6 +272,36 @@ pub(super) fn check_robot(robot: &urdf_rs::Robot, origin: &str) -> Result<(Vec<J
     }
     let mimics = couple(&actuated, &followers).map_err(bad)?;
     Ok((actuated, mimics))
+}
+
+/// Whether a massless `link` is a bare frame (no shape, no inertia) with a link of mass fixed
+/// to it, directly or through other fixed joints: the loader then moves that link in its place
+/// (rapier3d-urdf's `squeeze_empty_fixed_links`), so the joint turns a mass.
+fn carried_by_fixed_children(robot: &urdf_rs::Robot, link: &urdf_rs::Link) -> bool {
+    let t = &link.inertial.inertia;
+    let bare = link.visual.is_empty()
+        && link.collision.is_empty()
+        && [t.ixx, t.ixy, t.ixz, t.iyy, t.iyz, t.izz].iter().all(|v| *v == 0.0);
+    let mut names = vec![link.name.as_str()];
+    let mut k = 0;
+    while k < names.len() {
+        let parent = names[k];
+        k += 1;
+        for joint in robot
+            .joints
+            .iter()
+            .filter(|j| j.parent.link == parent && j.joint_type == urdf_rs::JointType::Fixed)
+        {
+            let Some(child) = robot.links.iter().find(|l| l.name == joint.child.link) else {
+                continue;
+            };
+            if child.inertial.mass.value > 0.0 {
+                return bare;
+            }
+            names.push(&child.name); // a tree ([`check_tree`], checked first): the walk ends
+        }
+    }
+    false
 }
 
 /// Refuses a joint graph that is not one tree (issue #38): a joint whose parent is its child,

@@ -6,6 +6,10 @@
 //!   absent range as no limit); an explicit `lower="0" upper="0"` is refused;
 //! - a `spherical` joint: three continuous joints `NAME_x`, `NAME_y`, `NAME_z` (rotations
 //!   about the joint frame's x, then the new y, then the new z) through two small frames;
+//! - a frame link (no shape, on a fixed joint) with a negligible mass and an inertia the
+//!   physics refuses, as exporters write tool frames (onshape-to-robot's `mass 1e-9`, zero
+//!   inertia: the SO-101's `gripper_frame_link`): loaded massless, so the loader folds it into
+//!   its parent, as it does a frame link without `<inertial>`;
 //! - with `balance_inertia` ([`super::LoadOptions`]): an `<inertia>` the physics refuses
 //!   (triangle inequality broken, not positive definite, too small): its principal moments
 //!   set to their mean (MuJoCo's `balanceinertia`), or, when that mean is still too small (an
@@ -21,6 +25,46 @@ use crate::pose::origin_pose;
 /// Share of the child link's mass (and inertia) given to each of the two frames between the
 /// three joints a spherical joint becomes.
 pub(super) const GIMBAL_SHARE: f64 = 1e-3;
+
+/// A mass at most this share of the robot's is negligible on a frame link ([`massless_frames`]).
+pub(super) const FRAME_MASS_SHARE: f64 = 1e-6;
+
+/// Loads as massless every link with no visual or collision shape, attached by a fixed joint,
+/// whose mass is at most [`FRAME_MASS_SHARE`] of the robot's and whose inertia the physics
+/// cannot take (`refused`): a named frame, whose mass cannot matter.
+pub(super) fn massless_frames(
+    robot: &mut urdf_rs::Robot,
+    refused: impl Fn(f64, &urdf_rs::Inertia) -> bool,
+    warnings: &mut Vec<String>,
+) {
+    let total: f64 = robot
+        .links
+        .iter()
+        .map(|l| l.inertial.mass.value)
+        .filter(|m| m.is_finite())
+        .sum();
+    for link in &mut robot.links {
+        let mass = link.inertial.mass.value;
+        let fixed = robot
+            .joints
+            .iter()
+            .find(|j| j.child.link == link.name && j.joint_type == urdf_rs::JointType::Fixed);
+        let Some(joint) = fixed else { continue };
+        if link.visual.is_empty()
+            && link.collision.is_empty()
+            && mass > 0.0
+            && mass <= FRAME_MASS_SHARE * total
+            && refused(mass, &link.inertial.inertia)
+        {
+            warnings.push(format!(
+                "link {:?}: a frame (no shape, on fixed joint {:?}) with mass {mass:e} kg, under {FRAME_MASS_SHARE:e} of \
+                 the robot's, and an <inertia> the physics cannot take: loaded massless",
+                link.name, joint.name
+            ));
+            link.inertial = urdf_rs::Inertial::default();
+        }
+    }
+}
 
 /// Loads revolute joints without a range as continuous; `no_range` from the text scan.
 pub(super) fn unlimited_revolutes(robot: &mut urdf_rs::Robot, no_range: &HashSet<String>, warnings: &mut Vec<String>) {
