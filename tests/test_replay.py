@@ -99,6 +99,16 @@ def test_a_latentrl_train_run_on_a_custom_task_replays(tmp_path):
         with np.load(rolled / "rollout.npz") as npz:
             rows = np.isfinite(npz[f"{policy}_paths"][0, 1]).all(axis=1).sum()
         assert iio.imread(video).shape == (rows, 480, 960, 3)
+    # The tracking encoder's states are not stored: the drawn latent path says it is a projection.
+    from latentrl.replay import robot_episode
+    from latentrl.train import LatentPolicy
+
+    saved = LatentPolicy.load(run / "policy.npz")
+    with np.load(rolled / "rollout.npz") as npz:
+        path = npz["greedy_paths"][0, 0]
+    drawn = robot_episode(saved.task, saved.model, saved.latent_low, saved.latent_high,
+                          path[np.isfinite(path).all(axis=1)], saved.weights[0], "t")
+    assert saved.model.encoder == "tracking" and "not the states the tracking encoder gave" in drawn.title
     moved = tmp_path / "moved"
     moved.mkdir()
     run.rename(moved / "glass")

@@ -120,6 +120,8 @@ def robot_episode(task: Any, model: Any, low: NDArray[np.float64], high: NDArray
     poses = np.stack([np.asarray(plant.pose_links(b, q)) for b, q in zip(base, joints)])
     plant.pose_links(base[0], joints[0])
     scene = Scene.of(task, plant, poses[..., :3].reshape(-1, 3), view)  # the target where it stands at the start
+    if getattr(model, "encoder", None) == "tracking":  # its states came from the commanded points, which no file keeps
+        title += "\nlatent path: each reached posture projected anew, not the states the tracking encoder gave"
     return Recorded(f"{task.name}: {title}", rows[:, slices["effectors"]].reshape(len(rows), -1, 3),
                     model._encode(joints), weights, low, high, model, scene.config["learner"], scene=scene,
                     poses=poses)

@@ -216,3 +216,24 @@ fn trials_repeat_bitwise_on_one_and_two_threads() {
         assert_eq!(r.trajectories[0].len() % task.row_len(), 0);
     }
 }
+
+/// A floating robot without a fall rule (a quadruped whose feet are spheres cannot name box
+/// soles) rests its lowest point on the floor at a reset: with the base at the origin, the
+/// Go1's feet had started 30 cm inside the floor, and the robot popped out upside down.
+#[test]
+fn a_floating_robot_without_a_fall_rule_starts_on_the_floor() {
+    let shipped = common::task("humanoid_lift");
+    let mut config = shipped.config().clone();
+    config.fall = None;
+    let task = std::sync::Arc::new(Task::new(config, shipped.model().clone(), "no fall").unwrap());
+    let d = common::lift_demos();
+    let mut p = TaskPlant::new(task, Some(&d)).unwrap();
+    for q in &d[3..] {
+        assert_eq!(p.reset(q), None);
+        let lowest = p.world().lowest_point().unwrap();
+        assert!(
+            (lowest - sim::fall::GROUND_CLEARANCE).abs() < 1e-6,
+            "lowest point at {lowest} m"
+        );
+    }
+}

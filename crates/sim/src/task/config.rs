@@ -398,7 +398,8 @@ params! {
         obstacles: Vec<ObstacleConfig> = Vec::new() => Rule::Nested,
         /// A waypoint to pass (`[waypoint]`), for the "passed" record.
         waypoint: Option<WaypointConfig> = None => Rule::Nested,
-        /// The fall rule of a floating robot (`[fall]`); none for no falls.
+        /// The fall rule of a floating robot (`[fall]`); none for no falls (a reset then rests
+        /// the robot's lowest point on the floor).
         fall: Option<FallConfig> = None => Rule::Nested,
         /// How episodes run and start (`[episode]`).
         episode: EpisodeConfig = EpisodeConfig::default() => Rule::Nested,

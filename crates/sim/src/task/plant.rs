@@ -22,7 +22,7 @@
 use std::sync::Arc;
 
 use latent_core::{EndReason, Plant, StepOutcome};
-use nalgebra::{Point3, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use rand::{Rng, RngExt};
 
 use super::{ConstraintKind, ObstacleTest, RuleCheck, Task, TestStart};
@@ -224,6 +224,14 @@ impl TaskPlant {
                 )?;
                 let base = self.world.base_pose().translation.z;
                 fall.min_base_height = floor.height + rule.base_height_fraction * (base - floor.height);
+            }
+            (None, Some(floor), None) if config.root == RootMode::Floating => {
+                // No sole to stand on: the robot's lowest point rests on the floor (the base at
+                // the origin had put a quadruped's feet 30 cm into it).
+                self.world.reset_with_base(posture, &Isometry3::identity())?;
+                let lowest = self.world.lowest_point().unwrap_or(floor.height);
+                let lift = Isometry3::translation(0.0, 0.0, floor.height + GROUND_CLEARANCE - lowest);
+                self.world.reset_with_base(posture, &lift)?;
             }
             _ => self.world.reset(posture)?,
         }

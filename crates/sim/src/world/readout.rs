@@ -100,6 +100,21 @@ impl World {
         Ok(self.frame_position(&self.frame(link, [0.0; 3])?))
     }
 
+    /// The height (m) of the robot's lowest collision point, from its bodies' poses as they are
+    /// (after a reset, before a step); `None` for a robot without collision shapes.
+    pub fn lowest_point(&self) -> Option<f64> {
+        self.link_colliders
+            .iter()
+            .filter_map(|(_, handle)| {
+                let collider = self.world.colliders.get(*handle)?;
+                let body = self.world.bodies.get(collider.parent()?)?;
+                let local = collider.position_wrt_parent().copied().unwrap_or_default();
+                let pose = *body.position() * local;
+                Some(f64::from(collider.shape().compute_aabb(&pose).mins.z))
+            })
+            .reduce(f64::min)
+    }
+
     /// World poses of every URDF link, in URDF link order (`None` for a link neither with a
     /// body nor fixed to one).
     pub fn link_poses(&self) -> Vec<Option<Isometry3<f64>>> {
