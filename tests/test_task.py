@@ -199,5 +199,5 @@ def test_a_robot_that_cannot_move_or_a_sole_without_a_box_is_refused_at_load(tmp
     text = lift.read_text()
     soles = next(line for line in text.splitlines() if line.startswith("soles"))
     path = write(tmp_path, text.replace(soles, 'soles = ["l_hand"]'), "lift.toml")
-    with pytest.raises(ValueError, match=r'fall.soles\[0\]: link "l_hand" has no box collision shape'):
+    with pytest.raises(ValueError, match=r'fall.soles\[0\]: link "l_hand" has no collision shape'):
         Task.load(path)

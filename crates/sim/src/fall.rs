@@ -8,9 +8,11 @@
 //!   read differently before the first step, docs/pitfalls.md §rapier3d).
 //! - **Support margin** ([`support_margin`]): signed distance (m) from the centre of mass
 //!   projected on the floor to the edge of the support polygon, positive inside. The polygon
-//!   is the 2-D convex hull of the bottom corners of the sole boxes that are within
-//!   [`SOLE_CONTACT_TOLERANCE`] of the lowest sole corner (a tipping foot keeps only its
-//!   touching edge).
+//!   is the 2-D convex hull of the sole points ([`sole_points`]: the corners of the soles' box
+//!   shapes, the lowest point of their other shapes) within [`SOLE_CONTACT_TOLERANCE`] of the
+//!   lowest (a tipping foot keeps only its touching edge).
+//! - **Soles without a box** (a quadruped's sphere feet): no sole plane to tilt or to stand
+//!   flat, so their tilt is not tested and a reset stands the robot upright on its lowest point.
 
 use latent_core::CoreError;
 use nalgebra::{Isometry3, Point2, Point3, Translation3, UnitQuaternion, Vector3};
@@ -62,7 +64,11 @@ impl World {
         let base_height = self.base_pose().translation.z;
         let mut sole_tilt: f64 = 0.0;
         for sole in &criteria.soles {
-            let up = self.link_pose(sole)?.rotation * nalgebra::Vector3::z();
+            let pose = self.link_pose(sole)?; // an unknown sole is an error, whatever its shapes
+            if !has_box(&self.model, sole) {
+                continue;
+            }
+            let up = pose.rotation * nalgebra::Vector3::z();
             sole_tilt = sole_tilt.max(up.z.clamp(-1.0, 1.0).acos());
         }
         let mut ground_contact = None;
@@ -105,6 +111,24 @@ pub fn center_of_mass(sim: &World) -> Result<Point3<f64>> {
         }));
     }
     Ok(Point3::from(sum / total))
+}
+
+/// Whether link `link` has a box collision shape: a sole plane to stand flat and to tilt.
+pub fn has_box(model: &UrdfModel, link: &str) -> bool {
+    model.robot.links.iter().filter(|l| l.name == link).any(|l| {
+        l.collision
+            .iter()
+            .any(|c| matches!(c.geometry, urdf_rs::Geometry::Box { .. }))
+    })
+}
+
+/// World points where sole `sole` may touch the floor: the corners of its box collision shapes
+/// and the lowest point of each other shape (a sphere foot's bottom, a mesh hull's lowest
+/// vertex).
+pub fn sole_points(sim: &World, sole: &str) -> Result<Vec<Point3<f64>>> {
+    let mut points = box_corners(sim, &sim.model, sole)?;
+    points.extend(sim.lowest_points_of(sole, |shape| shape.as_cuboid().is_none())?);
+    Ok(points)
 }
 
 /// World corners of every box collision shape of link `link`.
@@ -203,7 +227,7 @@ pub fn polygon_margin(p: Point2<f64>, hull: &[Point2<f64>]) -> f64 {
 pub fn support_margin(sim: &World, soles: &[String]) -> Result<f64> {
     let mut corners = Vec::new();
     for sole in soles {
-        corners.extend(box_corners(sim, &sim.model, sole)?);
+        corners.extend(sole_points(sim, sole)?);
     }
     let lowest = corners.iter().map(|c| c.z).fold(f64::INFINITY, f64::min);
     let touching: Vec<Point2<f64>> = corners
@@ -218,7 +242,9 @@ pub fn support_margin(sim: &World, soles: &[String]) -> Result<f64> {
 /// Resets the robot to `posture` with the first sole flat on the ground: the base is
 /// placed so that this sole's frame stands at `stance` (x, y), or keeps the x–y position it
 /// has at the identity base if `stance` is `None`, with the heading it has there, no roll or
-/// pitch, and its lowest box corner `clearance` (m) above `ground`.
+/// pitch, and its lowest box corner `clearance` (m) above `ground`. A sole without a box (no
+/// plane to stand flat) stands at `stance` the same way with the base upright, the robot's
+/// lowest point `clearance` above `ground`.
 pub fn reset_on_ground(
     sim: &mut World,
     posture: &[f64],
@@ -229,6 +255,14 @@ pub fn reset_on_ground(
 ) -> Result<()> {
     check_finite("ground height and clearance", &[ground, clearance])?;
     sim.reset_with_base(posture, &Isometry3::identity())?;
+    if !has_box(&sim.model, sole) {
+        let at = sim.link_pose(sole)?.translation;
+        let [x, y] = stance.unwrap_or([at.x, at.y]);
+        check_finite("stance", &[x, y])?;
+        let lowest = sim.lowest_point().unwrap_or(ground);
+        let base = Isometry3::translation(x - at.x, y - at.y, ground + clearance - lowest);
+        return sim.reset_with_base(posture, &base);
+    }
     let sole_pose = sim.link_pose(sole)?;
     let (_, _, yaw) = sole_pose.rotation.euler_angles();
     let [x, y] = stance.unwrap_or([sole_pose.translation.x, sole_pose.translation.y]);
@@ -243,13 +277,6 @@ pub fn reset_on_ground(
         .iter()
         .map(|c| c.z)
         .fold(f64::INFINITY, f64::min);
-    if !lowest.is_finite() {
-        return Err(SimError::Input(CoreError::InvalidParameter {
-            name: "sole",
-            value: f64::NAN,
-            reason: "the sole link has no box collision shape",
-        }));
-    }
     let lifted = Isometry3::translation(0.0, 0.0, ground + clearance - lowest) * base;
     sim.reset_with_base(posture, &lifted)
 }

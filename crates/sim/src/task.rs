@@ -125,15 +125,15 @@ impl Task {
         if let Some(fall) = &config.fall {
             for (i, s) in fall.soles.iter().enumerate() {
                 link(format!("fall.soles[{i}]"), s)?;
-                let boxed = model.robot.links.iter().filter(|l| &l.name == s).any(|l| {
-                    l.collision
-                        .iter()
-                        .any(|c| matches!(c.geometry, rapier3d_urdf::urdf_rs::Geometry::Box { .. }))
-                });
-                if !boxed {
+                let shaped = model
+                    .robot
+                    .links
+                    .iter()
+                    .any(|l| &l.name == s && !l.collision.is_empty());
+                if !shaped {
                     return Err(failed(format!(
-                        "fall.soles[{i}]: link \"{s}\" has no box collision shape (a sole's box corners make the \
-                         support polygon)"
+                        "fall.soles[{i}]: link \"{s}\" has no collision shape (a sole's shapes make the support \
+                         polygon and touch the floor)"
                     )));
                 }
             }

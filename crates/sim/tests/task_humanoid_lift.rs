@@ -230,6 +230,8 @@ fn a_floating_robot_without_a_fall_rule_starts_on_the_floor() {
     let mut p = TaskPlant::new(task, Some(&d)).unwrap();
     for q in &d[3..] {
         assert_eq!(p.reset(q), None);
+        // Its box feet keep their 8 corners and nothing else (Exp 3's support polygon as before).
+        assert_eq!(sim::fall::sole_points(p.world(), "l_foot").unwrap().len(), 8);
         let lowest = p.world().lowest_point().unwrap();
         assert!(
             (lowest - sim::fall::GROUND_CLEARANCE).abs() < 1e-6,

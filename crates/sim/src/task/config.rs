@@ -320,10 +320,12 @@ params! {
     /// The fall rule of a floating robot: ends the episode (code 4) when a sole tilts too far,
     /// a non-sole link touches the floor or the base sinks.
     pub struct FallConfig {
-        /// The links allowed to touch the floor; the first stands flat at a reset (box
-        /// collision shapes make the support polygon).
+        /// The links allowed to touch the floor; their collision shapes make the support polygon.
+        /// At a reset the first stands flat if it has a box shape; else (sphere feet) the robot
+        /// stands upright on its lowest point.
         soles: Vec<String> = Vec::new() => Rule::NonEmpty,
-        /// A sole leaning more than this from the vertical is a fall (rad; Experiment 3: 20°).
+        /// A sole with a box shape leaning more than this from the vertical is a fall (rad;
+        /// Experiment 3: 20°); a sole without one has no plane to lean.
         max_tilt: f64 = crate::fall::MAX_SOLE_TILT => Rule::open_closed(0.0, std::f64::consts::PI),
         /// The base below this share of its height above the floor at the reset is a fall
         /// (Experiment 3: half).

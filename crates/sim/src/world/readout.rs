@@ -115,6 +115,31 @@ impl World {
             .reduce(f64::min)
     }
 
+    /// The lowest world point of each collision shape of link `link` that `keep` accepts (by its
+    /// parry shape), from the bodies' poses as they are.
+    pub fn lowest_points_of(
+        &self,
+        link: &str,
+        keep: impl Fn(&dyn rapier3d::parry::shape::Shape) -> bool,
+    ) -> Result<Vec<Point3<f64>>> {
+        let index = self.model.link_index(link)?;
+        let down = rapier3d::prelude::Vector::new(0.0, 0.0, -1.0);
+        Ok(self
+            .link_colliders
+            .iter()
+            .filter(|(l, _)| *l == index)
+            .filter_map(|(_, handle)| {
+                let collider = self.world.colliders.get(*handle)?;
+                let shape = collider.shape();
+                let support = shape.as_support_map().filter(|_| keep(shape))?;
+                let body = self.world.bodies.get(collider.parent()?)?;
+                let pose = *body.position() * collider.position_wrt_parent().copied().unwrap_or_default();
+                let p = support.support_point(&pose, down);
+                Some(Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
+            })
+            .collect())
+    }
+
     /// World poses of every URDF link, in URDF link order (`None` for a link neither with a
     /// body nor fixed to one).
     pub fn link_poses(&self) -> Vec<Option<Isometry3<f64>>> {
