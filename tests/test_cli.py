@@ -33,6 +33,27 @@ def test_info_on_a_full_disk_says_so_in_one_line():
     assert result.stderr.strip() == "latentrl: error: cannot write to standard output: No space left on device"
 
 
+def test_a_closed_stderr_costs_no_result_and_sends_no_message_to_stdout(tmp_path):
+    """`latentrl train … 2>&-` exited 1 after its fit without a word (the progress bar asked the
+    missing stderr whether it is a terminal), and an error printed to the missing stderr went to
+    stdout. Each command runs as it would, silently on stderr."""
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    task, demos, run = str(example / "glass_arm.toml"), str(example / "demos.csv"), tmp_path / "run"
+
+    def closed_stderr(*args):
+        return subprocess.run([sys.executable, "-m", "latentrl", *args], stdout=subprocess.PIPE, text=True,
+                              preexec_fn=lambda: os.close(2), timeout=300)
+
+    trained = closed_stderr("train", task, "--demos", demos, "--quick", "--episodes", "10", "--trials", "1", "--out",
+                            str(run))
+    assert trained.returncode == 0 and "verdict: " in trained.stdout and (run / "report.json").is_file()
+    assert closed_stderr("check", task, "--demos", demos).returncode == 0
+    assert closed_stderr("rollout", str(run), "--out", str(tmp_path / "rollout"), "--episodes", "2").returncode == 0
+    assert (tmp_path / "rollout" / "rollout.json").is_file()
+    refused = closed_stderr("fit", str(tmp_path / "missing.csv"), "--out", str(tmp_path / "m.npz"))
+    assert refused.returncode == 1 and refused.stdout == ""
+
+
 def test_a_terminal_that_lacks_a_character_gets_its_escape_not_an_error():
     """PYTHONIOENCODING=ascii (or latin-1, a Latin-1 locale): `train --help` failed on "…", `check` after its
     survey on "×", `train` after its fit on "−", each exit 1."""

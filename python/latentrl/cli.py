@@ -72,7 +72,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _tolerant_streams() -> None:
     """stdout and stderr write a character their encoding lacks as its escape (``\\u2212``)
     instead of failing: on an ASCII or Latin-1 terminal (PYTHONIOENCODING, the locale) `train`
-    failed after its fit printing "−", `--help` on "…"."""
+    failed after its fit printing "−", `--help` on "…". A closed stderr (`2>&-`) becomes
+    os.devnull: Python leaves it None, and a message printed to None went to stdout."""
+    if sys.stderr is None:
+        sys.stderr = open(os.devnull, "w")  # for the life of the process
     for stream in (sys.stdout, sys.stderr):
         if isinstance(stream, io.TextIOWrapper):
             stream.reconfigure(errors="backslashreplace")
