@@ -30,7 +30,41 @@ def test_info_on_a_full_disk_says_so_in_one_line():
         result = subprocess.run([sys.executable, "-m", "latentrl", "info"], stdout=full, stderr=subprocess.PIPE,
                                 text=True)
     assert result.returncode == 1 and "Traceback" not in result.stderr
-    assert result.stderr.strip() == "latentrl: error: cannot write to standard output: No space left on device"
+    assert result.stderr.strip() == "latentrl: error: cannot write to standard output: [Errno 28] No space left on device"
+
+
+def test_a_reader_gone_or_a_full_disk_on_stdout_stops_the_printing_not_the_work(tmp_path, capfd):
+    """`latentrl train … | head -2` trained, then exited 1 ("[Errno 32] Broken pipe") without
+    writing report.json; `report RUN | head -1`, `check … | true` exited 1 so. As other CLIs: the
+    command finishes silently with its own exit code; a full disk for stdout is one line, exit 1,
+    after the files are written."""
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    train = ["train", str(example / "glass_arm.toml"), "--demos", str(example / "demos.csv"), "--quick", "--episodes",
+             "10", "--trials", "1", "--out"]
+
+    def no_reader(*args, stderr_too=False):
+        read, write = os.pipe()
+        os.close(read)
+        try:
+            return subprocess.run([sys.executable, "-m", "latentrl", *args], stdout=write,
+                                  stderr=write if stderr_too else subprocess.PIPE, text=True, timeout=300)
+        finally:
+            os.close(write)
+
+    assert no_reader(*train, str(tmp_path / "run"), stderr_too=True).returncode == 0  # `2>&1 | head -2`, progress too
+    assert (tmp_path / "run" / "report.json").is_file()
+    for args in (["report", str(tmp_path / "run")], ["info"]):
+        result = no_reader(*args)
+        assert (result.returncode, result.stderr) == (0, ""), (args, result.stderr)
+    with open("/dev/full", "w") as full:
+        result = subprocess.run([sys.executable, "-m", "latentrl", *train, str(tmp_path / "full"), "--no-progress"],
+                                stdout=full, stderr=subprocess.PIPE, text=True, timeout=300)
+    assert result.returncode == 1 and (tmp_path / "full" / "report.json").is_file()
+    assert result.stderr == "latentrl: error: cannot write to standard output: [Errno 28] No space left on device\n"
+    # In this process, the streams are put back, flushed: what follows main() is not held in a buffer.
+    assert main(["info"]) == 0
+    print("after")
+    assert capfd.readouterr().out.endswith("}\nafter\n")
 
 
 def test_a_closed_stderr_costs_no_result_and_sends_no_message_to_stdout(tmp_path):

@@ -5,16 +5,20 @@ exit codes (`latentrl.cli_parser.DESCRIPTION` lists them)."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import io
 import os
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from latentrl.cli_commands import COMMANDS
 from latentrl.cli_parser import build_parser
+
+if TYPE_CHECKING:
+    from _typeshed import ReadableBuffer
 
 __all__ = ["build_parser", "main"]
 
@@ -63,10 +67,17 @@ RECORDING_LIBRARIES = ("pyarrow", "h5py", "rosbags")
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
     _tolerant_streams()
-    args = build_parser().parse_args(argv)
-    with warnings.catch_warnings():
-        warnings.showwarning = _show_warning
-        return _run(args)
+    with _kept_going() as stdout:
+        args = build_parser().parse_args(argv)
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            code = _run(args)
+        if stdout is not None:
+            sys.stdout.flush()
+            if stdout.failed is not None:
+                print(f"latentrl: error: cannot write to standard output: {stdout.failed}", file=sys.stderr)
+                code = 1
+    return code
 
 
 def _tolerant_streams() -> None:
@@ -79,6 +90,59 @@ def _tolerant_streams() -> None:
     for stream in (sys.stdout, sys.stderr):
         if isinstance(stream, io.TextIOWrapper):
             stream.reconfigure(errors="backslashreplace")
+
+
+class _KeepGoing(io.FileIO):
+    """A standard stream's file descriptor whose failure ends the printing, not the command: a
+    reader gone (`latentrl train … | head -2`: the train ran, then exited 1 without report.json)
+    or a full disk points it at os.devnull (Python's recipe for a closed pipe), and the command
+    finishes and writes its files. A failure other than a closed pipe is kept in `failed`."""
+
+    failed: OSError | None = None
+
+    def write(self, data: ReadableBuffer) -> int:
+        try:
+            return super().write(data)
+        except OSError as err:
+            if not isinstance(err, BrokenPipeError):
+                self.failed = err
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, self.fileno())
+            os.close(devnull)
+            return memoryview(data).nbytes
+
+
+@contextlib.contextmanager
+def _kept_going() -> Iterator[_KeepGoing | None]:
+    """While a command runs, sys.stdout and sys.stderr write through a `_KeepGoing` each
+    (`_keep_going`), flushed and put back at the end (a caller in this process, a test, reads
+    what follows as before); yields stdout's, None if it has no file descriptor."""
+    saved = sys.stdout, sys.stderr
+    files = {name: _keep_going(name) for name in ("stdout", "stderr")}
+    try:
+        yield files["stdout"]
+    finally:
+        for name, file in files.items():
+            if file is not None:
+                getattr(sys, name).flush()
+        sys.stdout, sys.stderr = saved
+
+
+def _keep_going(name: str) -> _KeepGoing | None:
+    """`sys.<name>` (stdout, stderr) written through a `_KeepGoing`, its encoding and buffering
+    kept; None where it has no file descriptor (closed, or a stream in memory), left as it is."""
+    stream = getattr(sys, name)
+    if not isinstance(stream, io.TextIOWrapper):
+        return None
+    try:
+        fd = stream.fileno()
+    except OSError:  # io.UnsupportedOperation: a stream in memory
+        return None
+    stream.flush()
+    raw = _KeepGoing(fd, "w", closefd=False)
+    setattr(sys, name, io.TextIOWrapper(io.BufferedWriter(raw), encoding=stream.encoding, errors=stream.errors,
+                                        line_buffering=stream.line_buffering, write_through=stream.write_through))
+    return raw
 
 
 def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,

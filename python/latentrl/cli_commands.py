@@ -361,12 +361,7 @@ def _urdf_info(args: argparse.Namespace) -> int:
 def _info(args: argparse.Namespace) -> int:
     from latentrl.results import environment
 
-    text = json.dumps(environment(), indent=2)
-    try:
-        print(text, flush=True)
-    except OSError as err:  # e.g. stdout a full disk: say so once, not again at exit's flush
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        raise OSError(f"cannot write to standard output: {err.strerror}") from None
+    print(json.dumps(environment(), indent=2))
     return 0
 
 
