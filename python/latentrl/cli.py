@@ -23,11 +23,19 @@ if TYPE_CHECKING:
 __all__ = ["build_parser", "main"]
 
 
+NAME_MAX = 255
+"""The most bytes of a file or folder name (ext4, XFS, Btrfs, APFS, tmpfs)."""
+
+
 def _check_writable(flag: str, out: Path, *, file: bool) -> None:
     """The output `out` of `flag` can be written: its nearest existing ancestor is a writable
     directory (missing folders are made, for a file as for a folder) and it is not a directory
     where a file goes, or a file where a directory goes. Checked before any fit, trial or
-    frame, so a typo costs nothing."""
+    frame, so a typo costs nothing. No name on its path may be longer than `NAME_MAX` bytes."""
+    long = next((part for part in out.parts if len(os.fsencode(part)) > NAME_MAX), None)
+    if long is not None:
+        raise ValueError(f"{flag} {out}: the name {long[:24]}… is {len(os.fsencode(long))} bytes long, more than "
+                         f"the {NAME_MAX} a file or folder name may have")
     if out.exists() and out.is_dir() == file:
         raise ValueError(f"{flag} {out}: is {'a directory' if file else 'a file'}, expected {'a file' if file else 'a directory'}")
     if not file and out.is_symlink() and not out.exists():  # no folder can be made there (File exists, after the work)
