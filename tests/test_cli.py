@@ -118,6 +118,19 @@ def test_info_prints_versions_git_revision_and_threads_as_json():
     assert json.loads(one.stdout)["rayon_threads"] == 1
 
 
+def test_the_thread_count_recorded_is_the_one_rayon_reads(monkeypatch):
+    """`RAYON_NUM_THREADS=1_0` (or " 1") recorded 10 (1) threads in results.json: Python's int()
+    reads them, rayon (Rust's `usize::from_str`) does not and runs one per CPU."""
+    from latentrl.machine import worker_threads
+
+    cpus = len(os.sched_getaffinity(0))
+    for value, threads in [("1_0", cpus), (" 1", cpus), ("10", 10), ("+3", 3), ("007", 7), ("70000", 2**16 - 1),
+                           ("1\n", cpus), ("\u0663", cpus), ("0", cpus), ("-1", cpus), ("", cpus),
+                           ("2e1", cpus), (str(2**64), cpus)]:
+        monkeypatch.setenv("RAYON_NUM_THREADS", value)
+        assert worker_threads() == threads, value
+
+
 def test_help_documents_every_preset_flag():
     text = build_parser()._subparsers._group_actions[0].choices["run"].format_help()  # noqa: SLF001
     assert all(name in text for name in ("table1", "exp1", "exp2"))
