@@ -71,8 +71,6 @@ def _interruptible(work: Callable[[], object], out: Path, resume_command: str) -
 
 
 def _train(args: argparse.Namespace) -> int:
-    import matplotlib.pyplot  # noqa: F401  (the figures' [plot] extra: missing, exit 1 before any work)
-
     from latentrl._files import absolute
     from latentrl.experiments.training import check_resumable, prepared, run_training
 
