@@ -1,6 +1,6 @@
-"""The core of latentrl without matplotlib (the `[plot]` extra): models, envs, training and
-`latentrl fit` work; figures and `render_mode="rgb_array"` fail with a message naming the
-extra. Run as a script (by `tests/test_optional_deps.py` and `make install-check`); it hides
+"""The core of latentrl without matplotlib (the `[plot]` extra): models, envs, training,
+`latentrl fit` and `latentrl train` (all but its figures, which it says how to draw) work;
+figures and `render_mode="rgb_array"` fail with a message naming the extra. Run as a script (by `tests/test_optional_deps.py` and `make install-check`); it hides
 matplotlib itself, so it means the same in an environment that has it."""
 
 from __future__ import annotations
@@ -47,6 +47,14 @@ def main() -> None:
         save_demos(Demonstrations(arm_postures(20, np.random.default_rng(1)), Task.shipped("two_arms").joint_names), demos)
         with contextlib.redirect_stdout(io.StringIO()):
             assert cli(["fit", str(demos), "--out", str(Path(tmp) / "m.npz"), "--max-iter", "10"]) == 0
+        example, run = Path(__file__).resolve().parents[1] / "examples" / "glass_arm", Path(tmp) / "train"
+        stderr = io.StringIO()
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(stderr):
+            code = cli(["train", str(example / "glass_arm.toml"), "--demos", str(example / "demos.csv"), "--quick",
+                        "--episodes", "10", "--trials", "1", "--no-progress", "--out", str(run)])
+        assert code == 0 and (run / "policy.npz").is_file() and (run / "report.json").is_file(), stderr.getvalue()
+        assert not list(run.glob("*.png")), "figures without matplotlib"
+        assert f"pip install 'latentrl[plot]', then latentrl plot {run} draws them" in stderr.getvalue()
         stderr = io.StringIO()
         with contextlib.redirect_stderr(stderr):
             code = cli(["run", "exp2", "--quick", "--out", str(Path(tmp) / "run")])

@@ -30,7 +30,62 @@ def test_info_on_a_full_disk_says_so_in_one_line():
         result = subprocess.run([sys.executable, "-m", "latentrl", "info"], stdout=full, stderr=subprocess.PIPE,
                                 text=True)
     assert result.returncode == 1 and "Traceback" not in result.stderr
-    assert result.stderr.strip() == "latentrl: error: cannot write to standard output: No space left on device"
+    assert result.stderr.strip() == "latentrl: error: cannot write to standard output: [Errno 28] No space left on device"
+
+
+def test_a_reader_gone_or_a_full_disk_on_stdout_stops_the_printing_not_the_work(tmp_path, capfd):
+    """`latentrl train … | head -2` trained, then exited 1 ("[Errno 32] Broken pipe") without
+    writing report.json; `report RUN | head -1`, `check … | true` exited 1 so. As other CLIs: the
+    command finishes silently with its own exit code; a full disk for stdout is one line, exit 1,
+    after the files are written."""
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    train = ["train", str(example / "glass_arm.toml"), "--demos", str(example / "demos.csv"), "--quick", "--episodes",
+             "10", "--trials", "1", "--out"]
+
+    def no_reader(*args, stderr_too=False):
+        read, write = os.pipe()
+        os.close(read)
+        try:
+            return subprocess.run([sys.executable, "-m", "latentrl", *args], stdout=write,
+                                  stderr=write if stderr_too else subprocess.PIPE, text=True, timeout=300)
+        finally:
+            os.close(write)
+
+    assert no_reader(*train, str(tmp_path / "run"), stderr_too=True).returncode == 0  # `2>&1 | head -2`, progress too
+    assert (tmp_path / "run" / "report.json").is_file()
+    for args in (["report", str(tmp_path / "run")], ["info"]):
+        result = no_reader(*args)
+        assert (result.returncode, result.stderr) == (0, ""), (args, result.stderr)
+    with open("/dev/full", "w") as full:
+        result = subprocess.run([sys.executable, "-m", "latentrl", *train, str(tmp_path / "full"), "--no-progress"],
+                                stdout=full, stderr=subprocess.PIPE, text=True, timeout=300)
+    assert result.returncode == 1 and (tmp_path / "full" / "report.json").is_file()
+    assert result.stderr == "latentrl: error: cannot write to standard output: [Errno 28] No space left on device\n"
+    # In this process, the streams are put back, flushed: what follows main() is not held in a buffer.
+    assert main(["info"]) == 0
+    print("after")
+    assert capfd.readouterr().out.endswith("}\nafter\n")
+
+
+def test_a_closed_stderr_costs_no_result_and_sends_no_message_to_stdout(tmp_path):
+    """`latentrl train … 2>&-` exited 1 after its fit without a word (the progress bar asked the
+    missing stderr whether it is a terminal), and an error printed to the missing stderr went to
+    stdout. Each command runs as it would, silently on stderr."""
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    task, demos, run = str(example / "glass_arm.toml"), str(example / "demos.csv"), tmp_path / "run"
+
+    def closed_stderr(*args):
+        return subprocess.run([sys.executable, "-m", "latentrl", *args], stdout=subprocess.PIPE, text=True,
+                              preexec_fn=lambda: os.close(2), timeout=300)
+
+    trained = closed_stderr("train", task, "--demos", demos, "--quick", "--episodes", "10", "--trials", "1", "--out",
+                            str(run))
+    assert trained.returncode == 0 and "verdict: " in trained.stdout and (run / "report.json").is_file()
+    assert closed_stderr("check", task, "--demos", demos).returncode == 0
+    assert closed_stderr("rollout", str(run), "--out", str(tmp_path / "rollout"), "--episodes", "2").returncode == 0
+    assert (tmp_path / "rollout" / "rollout.json").is_file()
+    refused = closed_stderr("fit", str(tmp_path / "missing.csv"), "--out", str(tmp_path / "m.npz"))
+    assert refused.returncode == 1 and refused.stdout == ""
 
 
 def test_a_terminal_that_lacks_a_character_gets_its_escape_not_an_error():
@@ -61,6 +116,19 @@ def test_info_prints_versions_git_revision_and_threads_as_json():
     env = {**os.environ, "RAYON_NUM_THREADS": "1"}
     one = subprocess.run([sys.executable, "-m", "latentrl", "info"], capture_output=True, text=True, env=env)
     assert json.loads(one.stdout)["rayon_threads"] == 1
+
+
+def test_the_thread_count_recorded_is_the_one_rayon_reads(monkeypatch):
+    """`RAYON_NUM_THREADS=1_0` (or " 1") recorded 10 (1) threads in results.json: Python's int()
+    reads them, rayon (Rust's `usize::from_str`) does not and runs one per CPU."""
+    from latentrl.machine import worker_threads
+
+    cpus = len(os.sched_getaffinity(0))
+    for value, threads in [("1_0", cpus), (" 1", cpus), ("10", 10), ("+3", 3), ("007", 7), ("70000", 2**16 - 1),
+                           ("1\n", cpus), ("\u0663", cpus), ("0", cpus), ("-1", cpus), ("", cpus),
+                           ("2e1", cpus), (str(2**64), cpus)]:
+        monkeypatch.setenv("RAYON_NUM_THREADS", value)
+        assert worker_threads() == threads, value
 
 
 def test_help_documents_every_preset_flag():

@@ -1,4 +1,5 @@
 import json
+from pathlib import Path
 from unittest.mock import patch
 
 import numpy as np
@@ -244,6 +245,24 @@ def test_columns_the_joint_map_leaves_out_are_never_parsed(tmp_path, fast):
         write(tmp_path, "ragged.csv", "stamp,a,b\nx,0.1,0.2\ny,0.3,0.4,0.5\n")
         with pytest.raises(ValueError, match=r"line 3 \(posture 1\): 4 values, expected 3"):
             load_demos(tmp_path / "ragged.csv", joint_map={"stamp": ""})
+
+
+def test_a_column_of_text_is_refused_with_how_to_leave_it_out(tmp_path):
+    """A time stamp column (`latentrl check` of a recorder's CSV) said only "joint 'timestamp':
+    '2026-…' is not a number", where a numeric column that is no joint of the robot is told how
+    to leave it out (`--joint-map NAME=`). A bad value in a column of numbers is not."""
+    from latentrl import Task
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    rows = (example / "demos.csv").read_text().splitlines()
+    path = write(tmp_path, "d.csv", "\n".join([f"timestamp,{rows[0]}"] + [f"2026-12-07T00:00:{i:02d}.000,{row}"
+                                                                         for i, row in enumerate(rows[1:])]) + "\n")
+    with pytest.raises(ValueError, match=r"line 2 \(posture 0\), joint 'timestamp': '2026-12-07T00:00:00.000' is not "
+                                         r"a number; column 'timestamp' holds no number: a column that is no joint is "
+                                         r"left out with --joint-map timestamp= \(joint_map=\{'timestamp': ''\}\)"):
+        Task.load(example / "glass_arm.toml").demos(path)
+    with pytest.raises(ValueError, match=r"joint 'b': 'x' is not a number$"):
+        load_demos(write(tmp_path, "typo.csv", "a,b\n0.1,0.2\n0.3,x\n"))
 
 
 def test_an_empty_unnamed_column_is_absent_and_a_dataframe_index_is_named(tmp_path):

@@ -279,3 +279,18 @@ def test_an_out_folder_that_is_a_broken_symlink_is_refused_before_any_work(
     missing = str(tmp_path / "no-demos.csv")  # the --out check comes first: the demos are never read
     assert cli.main(["train", str(EXAMPLE / "glass_arm.toml"), "--demos", missing, "--out", str(out)]) == 1
     assert f"--out {out}: is a symbolic link to nothing" in capsys.readouterr().err
+
+
+def test_a_long_legal_output_name_is_written_and_one_too_long_is_refused_before_any_work(tmp_path: Path) -> None:
+    """An output name of 218–255 characters (legal) was refused after the work, "File name too
+    long": its temporary file's name added 38 characters. One longer than 255 bytes failed so
+    after the fit; it is refused first, naming the flag."""
+    from latentrl._persistence import atomic_path, atomic_write
+
+    atomic_write(tmp_path / ("h" * 251 + ".npz"), lambda f: f.write(b"x"))
+    with atomic_path(tmp_path / ("v" * 251 + ".gif")) as temp:
+        temp.write_bytes(b"x")
+    assert sorted(len(p.name) for p in tmp_path.iterdir()) == [255, 255]
+    result = cli("fit", str(EXAMPLE / "demos.csv"), "--out", str(tmp_path / ("h" * 253 + ".npz")))
+    assert result.returncode == 1 and f"--out {tmp_path}/hhh" in result.stderr
+    assert "is 257 bytes long, more than the 255 a file or folder name may have" in result.stderr

@@ -35,6 +35,15 @@ def test_a_terminal_keeps_the_tqdm_bar():
     bar.close()
 
 
+def test_a_closed_stderr_gets_no_bar(monkeypatch):
+    """`2>&-` leaves `sys.stderr` None: the bar asked it whether it is a terminal and the run
+    stopped with an AttributeError after its fit."""
+    monkeypatch.setattr(sys, "stderr", None)
+    with progress_bar(total=3, unit="ep", desc="episodes") as bar:
+        bar.update(3)
+    assert bar.disable
+
+
 def test_a_run_logged_to_a_file_has_no_carriage_returns(tmp_path):
     log = tmp_path / "log.txt"
     with log.open("w") as out:

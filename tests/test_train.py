@@ -372,6 +372,41 @@ def test_the_advice_follows_how_the_greedy_rollouts_failed_not_training() -> Non
     assert rising.rising and rising.verdict == "still improving below the target"
 
 
+def test_a_greedy_policy_below_the_random_control_is_told() -> None:
+    """A real run: greedy 0 %, soft-max 15 %, the random control 8 % from the same starts, and the
+    verdict ("stopped improving below the target") did not say that what `act()` runs does worse
+    than chance. Said in its lines and in report.json; not when greedy is level with the control."""
+    from types import SimpleNamespace
+    from typing import Any
+
+    from latentrl.episode_ends import end_reasons
+    from latentrl.rollout_summary import rollout_summary
+    from latentrl.verdict import training_verdict
+
+    timeout = end_reasons().index("timeout")
+    config = {"episode": {"max_steps": 100}, "learner": {"move_correction": False}, "target": {"hold_steps": 0}}
+    task = SimpleNamespace(to_dict=lambda: config)
+    reached = {"greedy": 0, "softmax": 3, "random": 2}  # of 20 rollouts: 0, 15 and 10 %
+
+    def rollout(episodes: int, seed: int, policy: str) -> dict[str, Any]:
+        run = {"ends": np.full((1, 20), timeout), "reached": np.arange(20)[None] < reached[policy],
+               "returns": np.full((1, 20), 10.0)}
+        return {**run, "summary": rollout_summary(run["ends"].ravel(), run["reached"].ravel(), run["returns"].ravel(),
+                                                  task)}
+
+    training = np.full((1, 50), timeout)
+    policy = SimpleNamespace(task=task, rollout=rollout, record={
+        "ends": training, "reached": np.arange(50)[None] < 5, "returns": np.zeros(training.shape)})
+    verdict = training_verdict(policy, episodes=20)
+    told = ("greedy reaches the target less often than the random control (0% vs 10%): it has learnt nothing "
+            "usable from these starts")
+    assert verdict.below_control == told and verdict.to_dict()["below_control"] == told
+    assert f"\n  {told}\n" in str(verdict)
+    reached["greedy"] = 2
+    level = training_verdict(policy, episodes=20)
+    assert level.below_control is None and "random control" not in str(level)
+
+
 def test_a_trial_stopped_in_a_dip_below_another_is_told() -> None:
     """Issue #37: the zoo's snake had trials stopped at 900 episodes far below one that ran on;
     run to the budget, it reached more. Stopped trials level with the best are not told."""

@@ -36,13 +36,19 @@ def naming_os_errors(path: Path) -> Iterator[None]:
         raise type(err)(err.errno, f"cannot write {path}: {err.strerror or err}") from err
 
 
+NAME_KEPT = 32
+"""The most characters of the name written that its temporary file's name keeps: a name of 218
+to 255 characters (legal) was refused after the work, its temporary's 38 more too long."""
+
+
 def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
     """Calls `write` (its result is ignored) on a temporary file beside `path` (creating
     missing parent directories), flushes it to disk, then renames it over `path`, so an
     interrupted write never leaves a half-written file. A process killed mid-write leaves
-    only `.{name}.<hex>.tmp` behind. An OSError names `path` (`naming_os_errors`)."""
+    only `.{name}.<hex>.tmp` behind (the name cut to `NAME_KEPT` characters). An OSError names
+    `path` (`naming_os_errors`)."""
     path = Path(path)
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    tmp = path.with_name(f".{path.name[:NAME_KEPT]}.{uuid.uuid4().hex}.tmp")
     try:
         with naming_os_errors(path):
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -59,12 +65,12 @@ def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
 @contextlib.contextmanager
 def atomic_path(path: PathLike) -> Iterator[Path]:
     """A temporary file name beside `path` (missing parent directories are made, as by
-    `atomic_write`) that keeps its suffix (for writers that take a name and choose the format by
-    it: imageio, rerun), renamed over `path` when the block ends and removed if it raises, so such
-    a writer never leaves a half-written `path`; an OSError in the block names `path`
-    (`naming_os_errors`)."""
+    `atomic_write`; its stem cut to `NAME_KEPT` characters) that keeps its suffix (for writers that
+    take a name and choose the format by it: imageio, rerun), renamed over `path` when the block
+    ends and removed if it raises, so such a writer never leaves a half-written `path`; an
+    OSError in the block names `path` (`naming_os_errors`)."""
     path = Path(path)
-    tmp = path.with_name(f".{path.stem}.{uuid.uuid4().hex}.tmp{path.suffix}")
+    tmp = path.with_name(f".{path.stem[:NAME_KEPT]}.{uuid.uuid4().hex}.tmp{path.suffix}")
     try:
         with naming_os_errors(path):
             path.parent.mkdir(parents=True, exist_ok=True)

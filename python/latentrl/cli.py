@@ -5,25 +5,37 @@ exit codes (`latentrl.cli_parser.DESCRIPTION` lists them)."""
 from __future__ import annotations
 
 import argparse
+import contextlib
 import io
 import os
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from latentrl.cli_commands import COMMANDS
 from latentrl.cli_parser import build_parser
 
+if TYPE_CHECKING:
+    from _typeshed import ReadableBuffer
+
 __all__ = ["build_parser", "main"]
+
+
+NAME_MAX = 255
+"""The most bytes of a file or folder name (ext4, XFS, Btrfs, APFS, tmpfs)."""
 
 
 def _check_writable(flag: str, out: Path, *, file: bool) -> None:
     """The output `out` of `flag` can be written: its nearest existing ancestor is a writable
     directory (missing folders are made, for a file as for a folder) and it is not a directory
     where a file goes, or a file where a directory goes. Checked before any fit, trial or
-    frame, so a typo costs nothing."""
+    frame, so a typo costs nothing. No name on its path may be longer than `NAME_MAX` bytes."""
+    long = next((part for part in out.parts if len(os.fsencode(part)) > NAME_MAX), None)
+    if long is not None:
+        raise ValueError(f"{flag} {out}: the name {long[:24]}… is {len(os.fsencode(long))} bytes long, more than "
+                         f"the {NAME_MAX} a file or folder name may have")
     if out.exists() and out.is_dir() == file:
         raise ValueError(f"{flag} {out}: is {'a directory' if file else 'a file'}, expected {'a file' if file else 'a directory'}")
     if not file and out.is_symlink() and not out.exists():  # no folder can be made there (File exists, after the work)
@@ -63,19 +75,82 @@ RECORDING_LIBRARIES = ("pyarrow", "h5py", "rosbags")
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the `latentrl` console script."""
     _tolerant_streams()
-    args = build_parser().parse_args(argv)
-    with warnings.catch_warnings():
-        warnings.showwarning = _show_warning
-        return _run(args)
+    with _kept_going() as stdout:
+        args = build_parser().parse_args(argv)
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            code = _run(args)
+        if stdout is not None:
+            sys.stdout.flush()
+            if stdout.failed is not None:
+                print(f"latentrl: error: cannot write to standard output: {stdout.failed}", file=sys.stderr)
+                code = 1
+    return code
 
 
 def _tolerant_streams() -> None:
     """stdout and stderr write a character their encoding lacks as its escape (``\\u2212``)
     instead of failing: on an ASCII or Latin-1 terminal (PYTHONIOENCODING, the locale) `train`
-    failed after its fit printing "−", `--help` on "…"."""
+    failed after its fit printing "−", `--help` on "…". A closed stderr (`2>&-`) becomes
+    os.devnull: Python leaves it None, and a message printed to None went to stdout."""
+    if sys.stderr is None:
+        sys.stderr = open(os.devnull, "w")  # for the life of the process
     for stream in (sys.stdout, sys.stderr):
         if isinstance(stream, io.TextIOWrapper):
             stream.reconfigure(errors="backslashreplace")
+
+
+class _KeepGoing(io.FileIO):
+    """A standard stream's file descriptor whose failure ends the printing, not the command: a
+    reader gone (`latentrl train … | head -2`: the train ran, then exited 1 without report.json)
+    or a full disk points it at os.devnull (Python's recipe for a closed pipe), and the command
+    finishes and writes its files. A failure other than a closed pipe is kept in `failed`."""
+
+    failed: OSError | None = None
+
+    def write(self, data: ReadableBuffer) -> int:
+        try:
+            return super().write(data)
+        except OSError as err:
+            if not isinstance(err, BrokenPipeError):
+                self.failed = err
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, self.fileno())
+            os.close(devnull)
+            return memoryview(data).nbytes
+
+
+@contextlib.contextmanager
+def _kept_going() -> Iterator[_KeepGoing | None]:
+    """While a command runs, sys.stdout and sys.stderr write through a `_KeepGoing` each
+    (`_keep_going`), flushed and put back at the end (a caller in this process, a test, reads
+    what follows as before); yields stdout's, None if it has no file descriptor."""
+    saved = sys.stdout, sys.stderr
+    files = {name: _keep_going(name) for name in ("stdout", "stderr")}
+    try:
+        yield files["stdout"]
+    finally:
+        for name, file in files.items():
+            if file is not None:
+                getattr(sys, name).flush()
+        sys.stdout, sys.stderr = saved
+
+
+def _keep_going(name: str) -> _KeepGoing | None:
+    """`sys.<name>` (stdout, stderr) written through a `_KeepGoing`, its encoding and buffering
+    kept; None where it has no file descriptor (closed, or a stream in memory), left as it is."""
+    stream = getattr(sys, name)
+    if not isinstance(stream, io.TextIOWrapper):
+        return None
+    try:
+        fd = stream.fileno()
+    except OSError:  # io.UnsupportedOperation: a stream in memory
+        return None
+    stream.flush()
+    raw = _KeepGoing(fd, "w", closefd=False)
+    setattr(sys, name, io.TextIOWrapper(io.BufferedWriter(raw), encoding=stream.encoding, errors=stream.errors,
+                                        line_buffering=stream.line_buffering, write_through=stream.write_through))
+    return raw
 
 
 def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,

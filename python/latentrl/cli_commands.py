@@ -71,8 +71,6 @@ def _interruptible(work: Callable[[], object], out: Path, resume_command: str) -
 
 
 def _train(args: argparse.Namespace) -> int:
-    import matplotlib.pyplot  # noqa: F401  (the figures' [plot] extra: missing, exit 1 before any work)
-
     from latentrl._files import absolute
     from latentrl.experiments.training import check_resumable, prepared, run_training
 
@@ -361,12 +359,7 @@ def _urdf_info(args: argparse.Namespace) -> int:
 def _info(args: argparse.Namespace) -> int:
     from latentrl.results import environment
 
-    text = json.dumps(environment(), indent=2)
-    try:
-        print(text, flush=True)
-    except OSError as err:  # e.g. stdout a full disk: say so once, not again at exit's flush
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        raise OSError(f"cannot write to standard output: {err.strerror}") from None
+    print(json.dumps(environment(), indent=2))
     return 0
 
 

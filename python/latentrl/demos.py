@@ -113,13 +113,20 @@ def _is_number(text: str) -> bool:
 def _table(rows: Sequence[tuple[str, Sequence[Any]]], names: Sequence[str],
            columns: Sequence[int]) -> NDArray[np.float64]:
     """(label, cells) rows → (N, len(columns)) floats of those `columns` (the others are never
-    parsed); ragged rows and non-numbers named by label and joint."""
+    parsed); ragged rows and non-numbers named by label and joint, a column without a number (a
+    time stamp, notes) with how to leave it out, as a numeric column that is no joint is told."""
     values = np.empty((len(rows), len(columns)))
     for i, (label, cells) in enumerate(rows):
         if len(cells) != len(names):
             raise ValueError(f"{label}: {len(cells)} values, expected {len(names)} (one per joint)")
         for k, j in enumerate(columns):
-            values[i, k] = _number(cells[j], f"{label}, joint {names[j]!r}")
+            try:
+                values[i, k] = _number(cells[j], f"{label}, joint {names[j]!r}")
+            except ValueError as err:
+                if any(_is_number(row[j]) for _, row in rows if len(row) == len(names)):
+                    raise
+                raise ValueError(f"{err}; column {names[j]!r} holds no number: a column that is no joint is left "
+                                 f"out with --joint-map {names[j]}= (joint_map={{{names[j]!r}: ''}})") from None
     return values
 
 

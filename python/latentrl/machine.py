@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import platform
+import re
 import resource
 import subprocess
 from pathlib import Path
@@ -83,16 +84,19 @@ def _blas() -> dict[str, Any]:
     }
 
 
+RAYON_MAX_THREADS = 2**16 - 1
+"""The most threads rayon runs in a pool (its `max_num_threads()` on 64-bit targets)."""
+
+
 def worker_threads() -> int:
-    """Threads the native trial runners use, as rayon picks them: RAYON_NUM_THREADS if it is a
-    positive integer, else the CPUs this process may run on. Runs are split into chunks of this
-    many trials; the results do not depend on it."""
-    try:
-        requested = int(os.environ.get("RAYON_NUM_THREADS", ""))
-    except ValueError:
-        requested = 0
-    if requested > 0:
-        return requested
+    """Threads the native trial runners use, as rayon picks them: RAYON_NUM_THREADS read as rayon
+    reads it (Rust's `usize::from_str`: ASCII digits after an optional "+"; Python's int() also
+    took "1_0" and " 1", which rayon ignores) if above 0 (at most `RAYON_MAX_THREADS`), else the
+    CPUs this process may run on. Runs are split into chunks of this many trials; the results do
+    not depend on it."""
+    requested = os.environ.get("RAYON_NUM_THREADS", "")
+    if re.fullmatch(r"\+?[0-9]+", requested) and 0 < int(requested) < 2**64:
+        return min(int(requested), RAYON_MAX_THREADS)
     return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
 
 

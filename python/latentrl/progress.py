@@ -28,8 +28,11 @@ class LogLines(tqdm):  # type: ignore[type-arg]  # tqdm's stubs leave it generic
 
 
 def progress_bar(*, disable: bool = False, file: TextIO | None = None, **kwargs: Any) -> tqdm:  # type: ignore[type-arg]
-    """A tqdm bar (keyword arguments as tqdm's) on a terminal, else `LogLines` every 10 s."""
+    """A tqdm bar (keyword arguments as tqdm's) on a terminal, else `LogLines` every 10 s; none
+    with stderr closed (`2>&-`: `sys.stderr` is None)."""
     stream = file if file is not None else sys.stderr
+    if stream is None:
+        return tqdm(disable=True, **kwargs)
     if stream.isatty():
         return tqdm(disable=disable, file=stream, **kwargs)
     kwargs.setdefault("bar_format", "{desc}: {n_fmt}/{total_fmt} {unit} [{elapsed} elapsed, {remaining} left, {rate_fmt}]")

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from latentrl._persistence import atomic_write
+from latentrl._persistence import NAME_KEPT, atomic_write
 from latentrl._files import MAX_JSON_BYTES, read_text
 from latentrl.machine import machine
 from latentrl.task import end_counts
@@ -28,7 +28,7 @@ RESULTS_FORMAT = 1
 def remove_stale_temporaries(path: Path) -> None:
     """Deletes temporary files that `atomic_write` left beside `path` when a process was killed
     while writing it (the file itself is always whole: the old or the new version)."""
-    for stale in path.parent.glob(f".{path.name}.*.tmp"):
+    for stale in path.parent.glob(f".{path.name[:NAME_KEPT]}.*.tmp"):
         stale.unlink(missing_ok=True)
 
 

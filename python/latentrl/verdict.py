@@ -13,6 +13,9 @@ such a rule, that comes within the reach radius at some step. One of four verdic
   last tenth of training (`RISING`) when the budget or the stopping rule ended it;
 - **stopped improving below the target**: anything between, no longer rising.
 
+A greedy policy that succeeds less often than the control from the same starts is said so,
+whatever the verdict: it has learnt nothing usable from them.
+
 With the verdict come the endings of the last fifth of the training episodes each trial ran, whether the reach
 rate was still rising there (more episodes may help), and the next things to try, taken from how
 the greedy rollouts that failed ended (the policy `act()` runs, not training's exploring
@@ -68,16 +71,21 @@ class Verdict:
     per_trial: dict[str, list[float]] = field(default_factory=dict)
     """Each policy's success share per trial: trials of one run may lie far apart (the zoo's
     snake: 0–70 % greedy), which the pooled share hides."""
+    below_control: str | None = None
+    """Said when the greedy policy succeeds less often than the random control (a real run:
+    greedy 0 %, soft-max 15 %, control 8 %, and the verdict did not say so)."""
 
     def to_dict(self) -> dict[str, Any]:
         """As written to report.json."""
         return {"verdict": self.verdict, "rollouts": self.rollouts, "late_ends": self.late_ends,
                 "late_ends_reached": self.late_ends_reached, "reach_late": self.reach_late, "rising": self.rising,
-                "next": self.next, "per_trial": self.per_trial}
+                "next": self.next, "per_trial": self.per_trial, "below_control": self.below_control}
 
     def __str__(self) -> str:
         lines = [f"verdict: {self.verdict}"]
         lines += [f"  {kind:8s} {format_rollout(summary)}" for kind, summary in self.rollouts.items()]
+        if self.below_control is not None:
+            lines.append(f"  {self.below_control}")
         if len(self.per_trial.get("greedy", ())) > 1:
             lines += [f"  {kind} per trial: {', '.join(f'{v:.0%}' for v in shares)}"
                       for kind, shares in self.per_trial.items() if kind != "random"]
@@ -154,8 +162,14 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
     rollouts = {kind: run["summary"] for kind, run in runs_of.items()}
     per_trial = {kind: [float(v) for v in succeeded(run, rollouts[kind]).reshape(np.shape(run["reached"])).mean(axis=1)]
                  for kind, run in runs_of.items()}  # trials × episodes
-    best = max(success_share(rollouts["greedy"]), success_share(rollouts["softmax"]))
+    greedy_share = success_share(rollouts["greedy"])
+    best = max(greedy_share, success_share(rollouts["softmax"]))
     control = success_share(rollouts["random"])
+    below_control = None
+    if greedy_share < control:
+        verb = "reaches the target" if rollouts["greedy"]["success"] is None else "succeeds"
+        below_control = (f"greedy {verb} less often than the random control ({greedy_share:.0%} vs {control:.0%}): "
+                         "it has learnt nothing usable from these starts")
     reached = np.asarray(policy.record["reached"], dtype=bool)
     ends = np.asarray(policy.record["ends"])
     runs = (ends >= 0).sum(axis=1)  # a trial the stopping rule ended ran fewer (ends −1 after)
@@ -199,4 +213,5 @@ def training_verdict(policy: Any, *, episodes: int = 20, seed: int = 0, findings
             steps.append("run latentrl check: its target and paths findings say whether the target can be reached")
         if findings is not None:
             steps += [f"{f.name}: {f.fix}" for f in findings.findings if f.verdict != "ok" and f.fix]
-    return Verdict(verdict, rollouts, late_ends, late_ends_reached, reach_late, bool(rising), steps, per_trial)
+    return Verdict(verdict, rollouts, late_ends, late_ends_reached, reach_late, bool(rising), steps, per_trial,
+                   below_control)

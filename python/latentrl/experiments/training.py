@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import json
+import warnings
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -318,11 +319,9 @@ def train_latent_policy(
 
 
 def run_training(run: TrainRun, out_dir: Path | str, *, progress: bool = True) -> dict[str, Any]:
-    """Runs (or continues) the training into `out_dir` with the one runner, draws its figures and
-    writes its policy (`policy.npz`); without matplotlib (the `[plot]` extra) it fails
-    (ModuleNotFoundError) before any work."""
-    import matplotlib.pyplot  # noqa: F401  (the figures' extra, checked before the trials run)
-
+    """Runs (or continues) the training into `out_dir` with the one runner, writes its policy
+    (`policy.npz`) and draws its figures; without matplotlib (the `[plot]` extra) everything but
+    the figures, with a warning saying how to draw them later."""
     from latentrl.experiments.runner import run_rl
 
     return run_rl(run, out_dir, setup=setup, figures=_policy_and_figures, progress=progress)
@@ -330,12 +329,22 @@ def run_training(run: TrainRun, out_dir: Path | str, *, progress: bool = True) -
 
 def _policy_and_figures(run: TrainRun, arrays: Mapping[str, np.ndarray], run_dir: Path, out: Path) -> None:
     """`policy.npz` (`save_policy`), then the `figures`: a disk that fills while they are drawn
-    keeps the policy (it was written after them, so `report` and `rollout` found none)."""
+    keeps the policy (it was written after them, so `report` and `rollout` found none). Without
+    matplotlib, a warning how to draw them later instead (`train` refused to start without it,
+    where the README trains after installing only the recording extras)."""
     try:
         save_policy(run, run_dir)
     except OSError as err:
         raise type(err)(err.errno, f"{err.strerror or err}; the same latentrl train command with --resume "
                                    "writes it once there is room") from err
+    try:
+        import matplotlib.pyplot  # noqa: F401  (the figures' [plot] extra)
+    except ModuleNotFoundError as err:
+        if err.name != "matplotlib":
+            raise
+        warnings.warn(f"no figures: they need matplotlib; pip install 'latentrl[plot]', then latentrl plot {run_dir} "
+                      "draws them", stacklevel=2)
+        return
     figures(run, arrays, run_dir, out)
 
 
