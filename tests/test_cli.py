@@ -501,3 +501,32 @@ def test_a_run_in_a_folder_named_in_latin1_finishes_and_reports(tmp_path):
     assert "lat\\udce9n" in LatentPolicy.load(out / "policy.npz").task.origin
     task = Task.from_dict(Task.load(example / "glass_arm.toml").to_dict(), example, origin=str(out))
     assert task.replace({"learner.alpha": 0.5}, origin=str(out)).origin == task.origin
+
+
+def test_report_prints_the_verdict_train_saved_for_this_policy(tmp_path, capsys, monkeypatch):
+    """`latentrl report DIR` made the check and the verdict's rollouts again (120–144 s on a real
+    arm, no progress shown) where report.json already held them: it prints report.json where
+    that was written for the policy.npz there now (its digest), and makes the verdict anew
+    otherwise (a report of an earlier version, or of the policy before a resume)."""
+    import latentrl.check
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "glass_arm"
+    out = tmp_path / "run"
+    assert main(["train", str(example / "glass_arm.toml"), "--demos", str(example / "demos.csv"), "--out", str(out),
+                 "--quick", "--trials", "1", "--episodes", "2", "--test-episodes", "1", "--episode.max-steps", "6",
+                 "--no-progress"]) == 0
+    trained = capsys.readouterr().out
+    saved = json.loads((out / "report.json").read_text())
+
+    def anew(*args, **kwargs):
+        raise AssertionError("the verdict was made anew")
+
+    monkeypatch.setattr(latentrl.check, "check_task", anew)
+    assert main(["report", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert printed.startswith("verdict: ") and printed.strip() in trained
+    assert main(["report", str(out), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out) == {k: saved[k] for k in saved if k not in ("policy_sha256", "environment")}
+    (out / "report.json").write_text(json.dumps({**saved, "policy_sha256": "0" * 64}))
+    with pytest.raises(AssertionError, match="made anew"):
+        main(["report", str(out)])

@@ -114,19 +114,27 @@ def _training_run(args: argparse.Namespace, files: dict[str, str]) -> Any:
 
 
 def _report_of(out: Path, *, write: bool = False, as_json: bool = False) -> None:
-    """The verdict on the policy in `out` (rollouts from the test starts, the check's advice);
-    printed, and with `write` saved as `out/report.json`."""
+    """The verdict on the policy in `out` (rollouts from the test starts, the check's advice):
+    the one `train` saved in `out/report.json` if it was written for the policy.npz there now,
+    else made anew; printed, and with `write` made anew and saved with that policy's digest."""
     from latentrl.check import check_task
+    from latentrl.experiments.run_folder import RunFolder
     from latentrl.results import environment, write_json
     from latentrl.train import LatentPolicy
-    from latentrl.verdict import training_verdict
+    from latentrl.verdict import Verdict, training_verdict
 
-    policy = LatentPolicy.load(out / "policy.npz")
-    findings = check_task(policy.task, policy.demos, policy.model, policy.latent_low, policy.latent_high)
-    found = training_verdict(policy, findings=findings)
+    folder = RunFolder(out)
+    saved = None if write else folder.saved_report()
+    if saved is not None:
+        found = Verdict.from_dict(saved)
+    else:
+        policy = LatentPolicy.load(out / "policy.npz")
+        findings = check_task(policy.task, policy.demos, policy.model, policy.latent_low, policy.latent_high)
+        found = training_verdict(policy, findings=findings)
     if write:
         with run_lock(out):
-            write_json(out / "report.json", {**found.to_dict(), "environment": environment()})
+            write_json(folder.report_path, {**found.to_dict(), "policy_sha256": folder.policy_digest(),
+                                            "environment": environment()})
     print(json.dumps(found.to_dict(), indent=2) if as_json else found)
 
 

@@ -25,7 +25,7 @@ by hovering beside the target) and from `latentrl check`'s findings.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -74,6 +74,13 @@ class Verdict:
     below_control: str | None = None
     """Said when the greedy policy succeeds less often than the random control (a real run:
     greedy 0 %, soft-max 15 %, control 8 %, and the verdict did not say so)."""
+
+    @classmethod
+    def from_dict(cls, saved: dict[str, Any]) -> Verdict:
+        """The verdict as `to_dict` wrote it (report.json; keys it lacks from an earlier version
+        take their defaults)."""
+        names = {f.name for f in fields(cls)}
+        return cls(**{k: v for k, v in saved.items() if k in names})
 
     def to_dict(self) -> dict[str, Any]:
         """As written to report.json."""

@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from latentrl._persistence import read_npz
+from latentrl._files import read_bounded
+from latentrl._persistence import MAX_NPZ_BYTES, read_npz
 from latentrl.experiments.presets import describe
 from latentrl.results import (
     MODEL_FILE,
@@ -23,6 +24,7 @@ from latentrl.results import (
     as_saved,
     finished_trials,
     gplvm_info,
+    read_json,
     read_results,
     remove_stale_temporaries,
 )
@@ -60,6 +62,26 @@ class RunFolder:
     def model_path(self) -> Path:
         """gplvm.npz: the GPLVM the trials learnt in (`MODEL_FILE`)."""
         return self.path / MODEL_FILE
+
+    @property
+    def report_path(self) -> Path:
+        """report.json: the verdict `latentrl train` made on policy.npz, with that file's digest."""
+        return self.path / "report.json"
+
+    def policy_digest(self) -> str:
+        """SHA-256 of policy.npz's bytes: the policy a report.json was written for."""
+        import hashlib  # OpenSSL: loaded by a run read back, not by `import latentrl`
+
+        return hashlib.sha256(read_bounded(self.path / "policy.npz", MAX_NPZ_BYTES, "a policy file")).hexdigest()
+
+    def saved_report(self) -> dict[str, Any] | None:
+        """report.json where it was written for the policy.npz there now (its `policy_sha256`);
+        None if there is none, or it is older than that policy (a resumed run, a report of an
+        earlier version without the digest): then the verdict is made anew."""
+        if not self.report_path.is_file():
+            return None
+        report = read_json(self.report_path)
+        return report if report.get("policy_sha256") == self.policy_digest() else None
 
     def holds_run(self) -> bool:
         """Whether a run saved its results here (results.json exists)."""
