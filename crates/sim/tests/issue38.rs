@@ -47,24 +47,34 @@ fn cube_stl() -> Vec<u8> {
     cube_stl_with(&[])
 }
 
+/// The unit cube's corner `i` (its bits are x, y, z).
+fn corner(i: usize) -> [f32; 3] {
+    [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32]
+}
+
+/// The unit cube's 12 triangles over its corners, outward.
+const CUBE_FACES: [[u32; 3]; 12] = [
+    [0, 2, 1],
+    [1, 2, 3],
+    [4, 5, 6],
+    [5, 7, 6],
+    [0, 1, 4],
+    [1, 5, 4],
+    [2, 6, 3],
+    [3, 6, 7],
+    [0, 4, 2],
+    [2, 4, 6],
+    [1, 3, 5],
+    [3, 7, 5],
+];
+
 /// A binary STL of the unit cube's 12 triangles, then `more` triangles.
 fn cube_stl_with(more: &[[[f32; 3]; 3]]) -> Vec<u8> {
-    let c = |i: usize| [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32];
-    let faces = [
-        [0, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6],
-        [0, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7],
-        [0, 4, 2],
-        [2, 4, 6],
-        [1, 3, 5],
-        [3, 7, 5],
-    ];
-    let triangles: Vec<[[f32; 3]; 3]> = faces.iter().map(|f| f.map(c)).chain(more.iter().copied()).collect();
+    let triangles: Vec<[[f32; 3]; 3]> = CUBE_FACES
+        .iter()
+        .map(|f| f.map(|i| corner(i as usize)))
+        .chain(more.iter().copied())
+        .collect();
     let mut out = vec![0u8; 80];
     out.extend((triangles.len() as u32).to_le_bytes());
     for t in triangles {
@@ -291,26 +301,14 @@ fn a_cached_hull_with_a_sliver_face_is_used() {
     let fresh = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
     // A hull as parry may write it: `m` on the surface, the four triangles around it tilted
     // inwards by 2 mrad, so the cube's far corners lie 2e-3 outside their planes.
-    let corners: Vec<[f32; 3]> = (0..8)
-        .map(|i| [(i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32])
+    let points: Vec<[f32; 3]> = (0..8).map(corner).chain([m]).collect();
+    let split = [[0, 2, 8], [8, 2, 1], [0, 8, 4], [8, 1, 4]]; // the faces at edge 0-1, through `m` (point 8)
+    let faces: Vec<[u32; 3]> = CUBE_FACES
+        .iter()
+        .filter(|f| **f != [0, 2, 1] && **f != [0, 1, 4])
+        .chain(&split)
+        .copied()
         .collect();
-    let points: Vec<[f32; 3]> = corners.into_iter().chain([m]).collect();
-    let faces = [
-        [0, 2, 8],
-        [8, 2, 1],
-        [1, 2, 3],
-        [4, 5, 6],
-        [5, 7, 6],
-        [0, 8, 4],
-        [8, 1, 4],
-        [1, 5, 4],
-        [2, 6, 3],
-        [3, 6, 7],
-        [0, 4, 2],
-        [2, 4, 6],
-        [1, 3, 5],
-        [3, 7, 5],
-    ];
     std::fs::write(entry(&cache), entry_bytes(&points, &faces, 13)).unwrap();
     let model = UrdfModel::from_file_with_cache(&urdf, Some(&cache)).unwrap();
     assert!(cached(&model) && model.warnings().is_empty(), "{:?}", model.warnings());
