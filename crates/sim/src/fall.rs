@@ -259,9 +259,7 @@ pub fn reset_on_ground(
         let at = sim.link_pose(sole)?.translation;
         let [x, y] = stance.unwrap_or([at.x, at.y]);
         check_finite("stance", &[x, y])?;
-        let lowest = sim.lowest_point().unwrap_or(ground);
-        let base = Isometry3::translation(x - at.x, y - at.y, ground + clearance - lowest);
-        return sim.reset_with_base(posture, &base);
+        return stand_upright(sim, posture, ground, clearance, [x - at.x, y - at.y]);
     }
     let sole_pose = sim.link_pose(sole)?;
     let (_, _, yaw) = sole_pose.rotation.euler_angles();
@@ -279,6 +277,18 @@ pub fn reset_on_ground(
         .fold(f64::INFINITY, f64::min);
     let lifted = Isometry3::translation(0.0, 0.0, ground + clearance - lowest) * base;
     sim.reset_with_base(posture, &lifted)
+}
+
+/// Resets the robot to `posture` with its base upright, moved by `shift` (x, y) from the
+/// origin and lifted so that its lowest collision point stands `clearance` (m) above `ground`
+/// (a robot without shapes: its base lifted by `clearance`). For robots with no sole to stand flat.
+pub fn stand_upright(sim: &mut World, posture: &[f64], ground: f64, clearance: f64, shift: [f64; 2]) -> Result<()> {
+    sim.reset_with_base(posture, &Isometry3::identity())?;
+    let lowest = sim.lowest_point().unwrap_or(ground);
+    sim.reset_with_base(
+        posture,
+        &Isometry3::translation(shift[0], shift[1], ground + clearance - lowest),
+    )
 }
 
 /// [`reset_on_ground`] on the world's own floor (an error if it has none), the sole where it

@@ -22,12 +22,12 @@
 use std::sync::Arc;
 
 use latent_core::{EndReason, Plant, StepOutcome};
-use nalgebra::{Isometry3, Point3, Vector3};
+use nalgebra::{Point3, Vector3};
 use rand::{Rng, RngExt};
 
 use super::{ConstraintKind, ObstacleTest, RuleCheck, Task, TestStart};
 use crate::error::{Result, SimError};
-use crate::fall::{FallCriteria, GROUND_CLEARANCE, reset_on_ground, support_margin};
+use crate::fall::{FallCriteria, GROUND_CLEARANCE, reset_on_ground, stand_upright, support_margin};
 use crate::shapes::{Obstacle, ObstacleShape};
 use crate::urdf::RootMode;
 use crate::world::{Frame, POSE_WIDTH, POSITION_WIDTH, World, WorldSnapshot};
@@ -228,10 +228,7 @@ impl TaskPlant {
             (None, Some(floor), None) if config.root == RootMode::Floating => {
                 // No sole to stand on: the robot's lowest point rests on the floor (the base at
                 // the origin had put a quadruped's feet 30 cm into it).
-                self.world.reset_with_base(posture, &Isometry3::identity())?;
-                let lowest = self.world.lowest_point().unwrap_or(floor.height);
-                let lift = Isometry3::translation(0.0, 0.0, floor.height + GROUND_CLEARANCE - lowest);
-                self.world.reset_with_base(posture, &lift)?;
+                stand_upright(&mut self.world, posture, floor.height, GROUND_CLEARANCE, [0.0, 0.0])?;
             }
             _ => self.world.reset(posture)?,
         }

@@ -100,18 +100,22 @@ impl World {
         Ok(self.frame_position(&self.frame(link, [0.0; 3])?))
     }
 
+    /// Each collision shape of the robot with its URDF link index and its world pose, from the
+    /// bodies' poses as they are (after a reset, before a step).
+    fn placed_shapes(&self) -> impl Iterator<Item = (usize, &dyn rapier3d::parry::shape::Shape, rapier3d::math::Pose)> {
+        self.link_colliders.iter().filter_map(|(link, handle)| {
+            let collider = self.world.colliders.get(*handle)?;
+            let body = self.world.bodies.get(collider.parent()?)?;
+            let pose = *body.position() * collider.position_wrt_parent().copied().unwrap_or_default();
+            Some((*link, collider.shape(), pose))
+        })
+    }
+
     /// The height (m) of the robot's lowest collision point, from its bodies' poses as they are
     /// (after a reset, before a step); `None` for a robot without collision shapes.
     pub fn lowest_point(&self) -> Option<f64> {
-        self.link_colliders
-            .iter()
-            .filter_map(|(_, handle)| {
-                let collider = self.world.colliders.get(*handle)?;
-                let body = self.world.bodies.get(collider.parent()?)?;
-                let local = collider.position_wrt_parent().copied().unwrap_or_default();
-                let pose = *body.position() * local;
-                Some(f64::from(collider.shape().compute_aabb(&pose).mins.z))
-            })
+        self.placed_shapes()
+            .map(|(_, shape, pose)| f64::from(shape.compute_aabb(&pose).mins.z))
             .reduce(f64::min)
     }
 
@@ -125,16 +129,10 @@ impl World {
         let index = self.model.link_index(link)?;
         let down = rapier3d::prelude::Vector::new(0.0, 0.0, -1.0);
         Ok(self
-            .link_colliders
-            .iter()
-            .filter(|(l, _)| *l == index)
-            .filter_map(|(_, handle)| {
-                let collider = self.world.colliders.get(*handle)?;
-                let shape = collider.shape();
-                let support = shape.as_support_map().filter(|_| keep(shape))?;
-                let body = self.world.bodies.get(collider.parent()?)?;
-                let pose = *body.position() * collider.position_wrt_parent().copied().unwrap_or_default();
-                let p = support.support_point(&pose, down);
+            .placed_shapes()
+            .filter(|(l, shape, _)| *l == index && keep(*shape))
+            .filter_map(|(_, shape, pose)| {
+                let p = shape.as_support_map()?.support_point(&pose, down);
                 Some(Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
             })
             .collect())
